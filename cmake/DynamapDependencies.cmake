@@ -1,0 +1,20 @@
+# Order matters (BUILD_NOTES): TBB's own config first, so that OpenVDB's module and Ceres's
+# SuiteSparse lookup agree on TBB::tbb.
+find_package(TBB CONFIG REQUIRED)
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d video calib3d dnn)
+find_package(Ceres REQUIRED)
+find_package(yaml-cpp REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+
+if(DYNAMAP_WITH_OPENVDB)
+  list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
+  find_package(OpenVDB REQUIRED)
+endif()
+if(DYNAMAP_WITH_OCTOMAP)
+  find_package(octomap REQUIRED)
+endif()
+if(DYNAMAP_WITH_PCL)
+  find_package(PCL 1.10 REQUIRED COMPONENTS common io filters kdtree)
+endif()

@@ -1,0 +1,43 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/frame.hpp"
+
+namespace dynamap {
+
+/// Frame-to-frame feature matches (from LK optical flow) between the previous and the current
+/// frame, in pixels. prev_px[i] <-> cur_px[i].
+struct FeatureMatches {
+  std::vector<cv::Point2f> prev_px;
+  std::vector<cv::Point2f> cur_px;
+};
+
+/// What the tracker hands to the dynamic-point stage, between matching and pose estimation.
+struct MotionFilterInput {
+  const RgbdFrame* frame = nullptr;  ///< current frame (colour, depth)
+  const cv::Mat* prev_gray = nullptr;
+  const cv::Mat* cur_gray = nullptr;
+  const FeatureMatches* matches = nullptr;
+};
+
+/// Result of the dynamic-point stage.
+struct MotionFilterOutput {
+  std::vector<std::uint8_t> match_is_dynamic;  ///< one flag per match (1 = dynamic)
+  cv::Mat dynamic_mask;  ///< CV_8UC1, 255 = moving region; empty = nothing moving
+};
+
+/// Hook between feature matching and pose estimation. The tracker drops dynamic matches and
+/// every feature inside `dynamic_mask` from pose estimation, bundle adjustment and new
+/// landmarks, and attaches the mask to keyframe packets.
+/// Called from the tracking thread only; implementations need not be thread-safe.
+class MotionFilter {
+ public:
+  virtual ~MotionFilter() = default;
+  virtual MotionFilterOutput filter(const MotionFilterInput& input) = 0;
+};
+
+}  // namespace dynamap
