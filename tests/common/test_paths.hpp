@@ -8,7 +8,9 @@
 namespace dynamap::test {
 
 /// ../shared/data beside the checkout.
-inline std::filesystem::path sharedData() { return std::filesystem::path(DYNAMAP_SHARED_DIR) / "data"; }
+inline std::filesystem::path sharedData() {
+  return std::filesystem::path(DYNAMAP_SHARED_DIR) / "data";
+}
 inline std::filesystem::path sharedModels() {
   return std::filesystem::path(DYNAMAP_SHARED_DIR) / "models";
 }
@@ -26,9 +28,9 @@ inline std::filesystem::path freshTempDir(const std::string& name) {
 }  // namespace dynamap::test
 
 /// Real-data tests need ../shared; CI always has it.
-#define DYNAMAP_REQUIRE_SHARED_DATA()                                                     \
-  do {                                                                                    \
-    if (!std::filesystem::exists(::dynamap::test::sharedData())) {                        \
+#define DYNAMAP_REQUIRE_SHARED_DATA()                                                         \
+  do {                                                                                        \
+    if (!std::filesystem::exists(::dynamap::test::sharedData())) {                            \
       GTEST_SKIP() << "../shared/data not found beside the checkout: " << DYNAMAP_SHARED_DIR; \
-    }                                                                                     \
+    }                                                                                         \
   } while (0)

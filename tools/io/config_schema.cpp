@@ -52,8 +52,8 @@ void ConfigSchema::addDouble(const std::string& key, double* field, double min, 
     const double d = parseDouble(key, v, at);
     if (d < min || d > max) {
       std::ostringstream msg;
-      msg << at << ": key '" << key << "': value " << v << " out of range [" << min << ", "
-          << max << "]";
+      msg << at << ": key '" << key << "': value " << v << " out of range [" << min << ", " << max
+          << "]";
       throw ConfigError(msg.str());
     }
     *field = d;
@@ -156,8 +156,8 @@ void ConfigSchema::loadYamlString(const std::string& text, const std::string& or
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " +
-                      e.msg);
+    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1) +
+                      ": YAML syntax error: " + e.msg);
   }
   if (root.IsNull()) return;
   if (!root.IsMap()) throw ConfigError(origin + ": top level must be a mapping of sections");
@@ -208,8 +208,7 @@ void ConfigSchema::applyOverride(const std::string& assignment) {
   if (eq == std::string::npos || eq == 0) {
     throw ConfigError("--set '" + assignment + "': expected section.key=value");
   }
-  setValue(trim(assignment.substr(0, eq)), trim(assignment.substr(eq + 1)),
-           "--set " + assignment);
+  setValue(trim(assignment.substr(0, eq)), trim(assignment.substr(eq + 1)), "--set " + assignment);
 }
 
 std::vector<std::string> ConfigSchema::keys() const {
@@ -218,31 +217,65 @@ std::vector<std::string> ConfigSchema::keys() const {
   return out;
 }
 
-std::string ConfigSchema::dumpYaml() const {
-  YAML::Node root;
-  auto assign = [&root](const std::string& key, const YAML::Node& value) {
-    std::vector<std::string> parts;
-    std::stringstream ss(key);
-    std::string p;
-    while (std::getline(ss, p, '.')) parts.push_back(p);
-    std::vector<YAML::Node> chain{root};
-    for (std::size_t i = 0; i + 1 < parts.size(); ++i) chain.push_back(chain.back()[parts[i]]);
-    chain.back()[parts.back()] = value;
-  };
-  for (const auto& [key, entry] : entries_) {
-    if (entry.is_list) {
-      YAML::Node list(YAML::NodeType::Sequence);
-      for (const auto& item : splitList(entry.get())) list.push_back(item);
-      assign(key, list);
+namespace {
+
+struct DumpTree {
+  std::map<std::string, DumpTree> children;
+  std::string scalar;
+  std::vector<std::string> list;
+  bool is_list = false;
+};
+
+void insertPath(DumpTree& root, const std::string& key, const DumpTree& leaf) {
+  DumpTree* node = &root;
+  std::stringstream ss(key);
+  std::string part;
+  while (std::getline(ss, part, '.')) node = &node->children[part];
+  node->scalar = leaf.scalar;
+  node->list = leaf.list;
+  node->is_list = leaf.is_list;
+}
+
+void emitTree(YAML::Emitter& out, const DumpTree& node) {
+  if (node.children.empty()) {
+    if (node.is_list) {
+      out << YAML::Flow << node.list;
     } else {
-      assign(key, YAML::Node(entry.get()));
+      out << node.scalar;
     }
+    return;
+  }
+  out << YAML::BeginMap;
+  for (const auto& [name, child] : node.children) {
+    out << YAML::Key << name << YAML::Value;
+    emitTree(out, child);
+  }
+  out << YAML::EndMap;
+}
+
+}  // namespace
+
+std::string ConfigSchema::dumpYaml() const {
+  DumpTree root;
+  for (const auto& [key, entry] : entries_) {
+    DumpTree leaf;
+    leaf.is_list = entry.is_list;
+    if (entry.is_list) {
+      leaf.list = splitList(entry.get());
+    } else {
+      leaf.scalar = entry.get();
+    }
+    insertPath(root, key, leaf);
   }
   for (const auto& [prefix, map] : prefixes_) {
-    for (const auto& [k, v] : *map) assign(prefix + "." + k, YAML::Node(v));
+    for (const auto& [k, v] : *map) {
+      DumpTree leaf;
+      leaf.scalar = v;
+      insertPath(root, prefix + "." + k, leaf);
+    }
   }
   YAML::Emitter out;
-  out << root;
+  emitTree(out, root);
   return std::string(out.c_str()) + "\n";
 }
 

@@ -24,12 +24,11 @@ class ConfigSchema {
   void addInt(const std::string& key, int* field, int min, int max);
   void addBool(const std::string& key, bool* field);
   /// `allowed` empty = any string.
-  void addString(const std::string& key, std::string* field,
-                 std::vector<std::string> allowed = {});
+  void addString(const std::string& key, std::string* field, std::vector<std::string> allowed = {});
   /// A YAML sequence of scalars, or a comma-separated string on the command line.
   void addStringList(const std::string& key, std::vector<std::string>* field);
-  /// Free-form keys below `prefix` (e.g. plugin parameters): "prefix.a.b: v" -> (*field)["a.b"]="v".
-  /// Whoever consumes them validates them.
+  /// Free-form keys below `prefix` (e.g. plugin parameters): "prefix.a.b: v" ->
+  /// (*field)["a.b"]="v". Whoever consumes them validates them.
   void addStringMap(const std::string& prefix, std::map<std::string, std::string>* field);
 
   /// Applies a YAML file on top of the current values. Throws ConfigError.

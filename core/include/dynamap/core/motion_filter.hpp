@@ -37,6 +37,10 @@ struct MotionFilterOutput {
 class MotionFilter {
  public:
   virtual ~MotionFilter() = default;
+  /// Called at the start of Tracker::track(), before feature matching, so that slow work
+  /// (e.g. the object detector) can run on its own thread while the tracker matches features.
+  virtual void beginFrame(const RgbdFrame& frame) = 0;
+  /// Called between matching and pose estimation with the frame passed to beginFrame().
   virtual MotionFilterOutput filter(const MotionFilterInput& input) = 0;
 };
 
