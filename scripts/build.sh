@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Configures and builds dynamap (Release by default) into ./build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${BUILD_DIR:-build}
+GENERATOR=()
+if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
+if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+  cmake -S . -B "$BUILD_DIR" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" "$@"
+fi
+cmake --build "$BUILD_DIR" -j"${JOBS:-2}"

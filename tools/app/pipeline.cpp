@@ -1,0 +1,239 @@
+#include "pipeline.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "dynamap/core/dynamic/motion_filter_factory.hpp"
+#include "dynamap/core/tracker.hpp"
+#include "dynamap/mapping/backend_registry.hpp"
+#include "dynamap/mapping/mapping_worker.hpp"
+#include "given_masks.hpp"
+#include "image_io.hpp"
+#include "output_files.hpp"
+#include "interrupt.hpp"
+#include "plugin_paths.hpp"
+#include "pose_lookup.hpp"
+
+namespace dynamap {
+
+namespace fs = std::filesystem;
+
+struct Pipeline::Stages {
+  PinholeCamera camera;
+  std::unique_ptr<MotionFilter> motion_filter;
+  GivenMaskFilter* given_masks = nullptr;  // == motion_filter.get() with --masks
+  std::unique_ptr<Tracker> tracker;        // null with --poses
+  std::unique_ptr<PoseLookup> given_poses;  // set with --poses
+  std::unique_ptr<MappingWorker> mapper;
+  std::uint64_t next_keyframe_id = 0;
+};
+
+namespace {
+
+constexpr std::size_t kMappingQueueCapacity = 16;
+
+std::map<std::string, std::string> backendParams(const MappingConfig& mapping) {
+  std::map<std::string, std::string> params;
+  const std::string prefix = mapping.backend + ".";
+  for (const auto& [key, value] : mapping.params) {
+    if (key.rfind(prefix, 0) == 0) params[key.substr(prefix.size())] = value;
+  }
+  return params;
+}
+
+std::string stampName(const std::string& rgb_path) { return fs::path(rgb_path).stem().string(); }
+
+class ProgressLine {
+ public:
+  ProgressLine(std::size_t total, bool quiet)
+      : total_(total), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
+  void update(std::size_t done) {
+    if (quiet_ || total_ == 0) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+    const bool last = done == total_;
+    const std::size_t step = std::max<std::size_t>(1, total_ / 10);
+    if (tty_ ? (elapsed - last_print_s_ < 0.5 && !last) : (done % step != 0 && !last)) return;
+    last_print_s_ = elapsed;
+    const double fps = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
+    const double eta = fps > 0 ? static_cast<double>(total_ - done) / fps : 0.0;
+    std::fprintf(stderr, "%sframe %zu/%zu  %.1f frames/s  ETA %.0f s%s", tty_ ? "\r" : "", done,
+                 total_, fps, eta, tty_ && !last ? "" : "\n");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  std::size_t total_;
+  bool quiet_;
+  bool tty_;
+  Clock::time_point start_;
+  double last_print_s_ = -1.0;
+};
+
+}  // namespace
+
+Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const TumSequence& sequence)
+    : options_(options), config_(config), sequence_(sequence), stages_(std::make_unique<Stages>()) {
+  auto& s = *stages_;
+  s.camera = config_.resolvedCamera();
+
+  // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
+  const auto registry = BackendRegistry::scan(pluginSearchPath());
+  auto backend = registry.create(config_.mapping.backend, backendParams(config_.mapping));
+  s.mapper = std::make_unique<MappingWorker>(std::move(backend), s.camera, StaticPointsOptions{},
+                                             kMappingQueueCapacity, &timings_);
+
+  if (!options_.masks_dir.empty()) {
+    if (!fs::is_directory(options_.masks_dir)) {
+      throw std::runtime_error(options_.masks_dir + ": --masks folder not found");
+    }
+    auto given = std::make_unique<GivenMaskFilter>(options_.masks_dir);
+    s.given_masks = given.get();
+    s.motion_filter = std::move(given);
+  }
+  if (!options_.poses_file.empty()) {
+    s.given_poses = std::make_unique<PoseLookup>(readTrajectory(options_.poses_file));
+    return;
+  }
+  if (!s.motion_filter) s.motion_filter = makeMotionFilter(config_.dynamic, s.camera, &timings_);
+  s.tracker = std::make_unique<Tracker>(s.camera, config_.tracking, &timings_);
+  s.tracker->setMotionFilter(s.motion_filter.get());
+}
+
+Pipeline::~Pipeline() = default;
+
+RunResult Pipeline::run() {
+  RunResult result;
+  result.backend = config_.mapping.backend;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    processFrames(result);
+  } catch (const std::exception& e) {
+    result.status = "failed";
+    result.error = e.what();
+  }
+  if (result.status == "complete" && interruptRequested()) result.status = "interrupted";
+  try {
+    finalize(result);
+  } catch (const std::exception& e) {
+    result.status = "failed";
+    result.error += std::string(result.error.empty() ? "" : "; then: ") + e.what();
+  }
+  result.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void Pipeline::processFrames(RunResult& result) {
+  const std::size_t total = sequence_.size();
+  ProgressLine progress(total, options_.quiet);
+  for (std::size_t i = 0; i < total; ++i) {
+    if (interruptRequested()) {
+      result.status = "interrupted";
+      std::fprintf(stderr, "\ninterrupted at frame %zu/%zu: writing what was computed\n", i,
+                   total);
+      return;
+    }
+    processFrame(i, result);
+    progress.update(i + 1);
+  }
+}
+
+void Pipeline::processFrame(std::size_t index, RunResult& result) {
+  auto& s = *stages_;
+  const SequenceEntry& entry = sequence_.entries()[index];
+  FrameLoad load = sequence_.load(index);
+  ++result.counts.frames_read;
+  if (!load.ok) {
+    ++result.counts.bad_frames;
+    std::fprintf(stderr, "\nbad frame %zu skipped: %s\n", index, load.error.c_str());
+    if (s.tracker) s.tracker->markBadFrame(entry.rgb_timestamp_s);
+    return;
+  }
+  const RgbdFrame& frame = load.frame;
+
+  if (s.given_poses) {  // mapping from given poses: every frame with a pose is a keyframe
+    const auto pose = s.given_poses->at(frame.timestamp_s);
+    if (!pose) return;
+    auto kf = std::make_shared<KeyframePacket>();
+    kf->id = s.next_keyframe_id++;
+    kf->timestamp_s = frame.timestamp_s;
+    kf->T_W_C = *pose;
+    kf->bgr = frame.bgr;
+    kf->depth_m = frame.depth_m;
+    if (s.given_masks) {
+      s.given_masks->setNextRgbPath(entry.rgb_path);
+      s.given_masks->beginFrame(frame);
+      kf->dynamic_mask = s.given_masks->filter({&frame, nullptr, nullptr, nullptr}).dynamic_mask;
+    }
+    result.trajectory.push_back({frame.timestamp_s, *pose});
+    result.frame_status.push_back("given");
+    result.keyframes.push_back({frame.timestamp_s, *pose});
+    ++result.counts.keyframes;
+    s.mapper->push(kf);
+    return;
+  }
+
+  if (s.given_masks) s.given_masks->setNextRgbPath(entry.rgb_path);
+  const TrackingResult tracked = s.tracker->track(frame);
+  if (tracked.is_keyframe && tracked.keyframe) {
+    s.mapper->push(tracked.keyframe);
+    if (options_.save_masks) writeKeyframeMask(entry, tracked);
+    if (options_.debug_images) writeDebugImage(entry, frame, tracked);
+  }
+  const auto updates = s.tracker->takePoseUpdates();
+  if (!updates.empty()) s.mapper->applyPoseUpdates(updates);
+}
+
+void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const {
+  const fs::path dir = fs::path(options_.out_dir) / "masks";
+  fs::create_directories(dir);
+  cv::Mat mask = tracked.keyframe->dynamic_mask;
+  if (mask.empty()) mask = cv::Mat::zeros(tracked.keyframe->bgr.size(), CV_8UC1);
+  writeImageAtomic((dir / (stampName(entry.rgb_path) + ".png")).string(), mask);
+}
+
+void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
+                               const TrackingResult& tracked) const {
+  const fs::path dir = fs::path(options_.out_dir) / "debug";
+  fs::create_directories(dir);
+  const cv::Mat picture = maskOverlay(frame.bgr, tracked.dynamic_mask);
+  writeImageAtomic((dir / (stampName(entry.rgb_path) + ".jpg")).string(), picture);
+}
+
+void Pipeline::finalize(RunResult& result) {
+  auto& s = *stages_;
+  if (s.tracker) {
+    s.tracker->finish();
+    const auto trajectory = s.tracker->finalTrajectory();
+    const auto statuses = s.tracker->frameStatuses();
+    for (std::size_t i = 0; i < trajectory.size(); ++i) {
+      result.trajectory.push_back({trajectory[i].first, trajectory[i].second});
+      result.frame_status.push_back(i < statuses.size() ? toString(statuses[i]) : "unknown");
+    }
+    std::vector<PoseUpdate> final_poses;
+    for (const auto& kf : s.tracker->keyframes()) {
+      result.keyframes.push_back({kf.timestamp_s, kf.T_W_C});
+      final_poses.push_back({kf.id, kf.T_W_C});
+    }
+    s.mapper->applyPoseUpdates(final_poses);
+    const TrackerStats stats = s.tracker->stats();
+    result.counts.tracked = stats.tracked;
+    result.counts.relocalized = stats.relocalized;
+    result.counts.lost = stats.lost;
+    result.counts.keyframes = stats.keyframes;
+  } else {
+    result.counts.tracked = result.trajectory.size();
+  }
+  s.mapper->finish();
+  result.counts.mapped_keyframes = s.mapper->stats().keyframes;
+  result.map_dir = (fs::path(options_.out_dir) / "map").string();
+  fs::create_directories(result.map_dir);
+  s.mapper->exportMap(result.map_dir);
+}
+
+}  // namespace dynamap

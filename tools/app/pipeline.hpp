@@ -1,0 +1,73 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app_config.hpp"
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/timing.hpp"
+#include "run_options.hpp"
+#include "trajectory_io.hpp"
+#include "tum_dataset.hpp"
+
+namespace dynamap {
+
+struct TrackingResult;
+
+/// Frame counts of a run, written to run.json.
+struct RunCounts {
+  std::size_t frames_read = 0;
+  std::size_t tracked = 0;
+  std::size_t relocalized = 0;
+  std::size_t lost = 0;
+  std::size_t bad_frames = 0;
+  std::size_t keyframes = 0;
+  std::size_t mapped_keyframes = 0;
+};
+
+/// What a run produced; filled even when it stops early.
+struct RunResult {
+  std::string status = "complete";  ///< complete | interrupted | failed
+  std::string error;
+  RunCounts counts;
+  std::vector<TimedPose> trajectory;  ///< every frame with a pose, final optimised poses
+  std::vector<std::string> frame_status;  ///< parallel to trajectory
+  std::vector<TimedPose> keyframes;
+  double wall_time_s = 0.0;
+  std::string backend;
+  std::string map_dir;
+};
+
+/// The run: frames -> tracking (with motion-area removal) -> keyframes -> mapping.
+/// Owns every stage for the duration of one sequence. Not thread-safe; one run at a time.
+class Pipeline {
+ public:
+  Pipeline(const RunOptions& options, const AppConfig& config, const TumSequence& sequence);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  /// Processes every frame (or until interrupted / a fatal error), then finalises: final
+  /// poses, map export. Never throws: a failure is recorded in the result, and whatever was
+  /// computed so far is still finalised.
+  RunResult run();
+  const TimingRecorder& timings() const { return timings_; }
+
+ private:
+  struct Stages;
+  void processFrames(RunResult& result);
+  void processFrame(std::size_t index, RunResult& result);
+  void finalize(RunResult& result);
+  void writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const;
+  void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
+                       const TrackingResult& tracked) const;
+
+  RunOptions options_;
+  AppConfig config_;
+  const TumSequence& sequence_;
+  TimingRecorder timings_;
+  std::unique_ptr<Stages> stages_;
+};
+
+}  // namespace dynamap

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace dynamap {
+
+/// What `dynamap run` was asked to do.
+struct RunOptions {
+  std::string config_path;              ///< empty = config/default.yaml defaults only
+  std::vector<std::string> overrides;   ///< "--set section.key=value"
+  std::string sequence_dir;
+  std::string out_dir;
+  std::string poses_file;  ///< map with these TUM poses instead of tracking
+  std::string masks_dir;   ///< use DIR/<timestamp>.png masks instead of computing them
+  bool save_masks = false;
+  bool debug_images = false;
+  bool quiet = false;
+};
+
+}  // namespace dynamap
