@@ -1,6 +1,7 @@
 // dynamap evaluate: ATE/RPE of an estimated trajectory against ground truth, as the TUM
 // RGB-D benchmark scripts compute them.
 #include <iostream>
+#include <memory>
 #include <string>
 
 #include "commands.hpp"

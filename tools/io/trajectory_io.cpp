@@ -1,0 +1,69 @@
+#include "trajectory_io.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include "image_io.hpp"
+
+namespace dynamap {
+namespace {
+
+/// Rotation of quaternion (x, y, z, w) as the benchmark's transform44 builds it: normalised;
+/// identity when the squared norm is below 4 * machine epsilon.
+Eigen::Matrix3d rotationFromQuaternion(double qx, double qy, double qz, double qw) {
+  const double squared_norm = qx * qx + qy * qy + qz * qz + qw * qw;
+  if (squared_norm < 4.0 * std::numeric_limits<double>::epsilon()) {
+    return Eigen::Matrix3d::Identity();
+  }
+  return Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+}
+
+}  // namespace
+
+std::vector<TimedPose> readTrajectory(const std::string& path) {
+  std::map<double, Eigen::Isometry3d> by_time;
+  for (const ListLine& line : readListFile(path)) {
+    if (line.fields.size() != 8) {
+      throw DatasetError(path + ":" + std::to_string(line.line_number) +
+                         ": expected 8 fields 'timestamp tx ty tz qx qy qz qw', found " +
+                         std::to_string(line.fields.size()));
+    }
+    static const std::array<const char*, 8> kNames = {"timestamp", "tx", "ty", "tz",
+                                                      "qx",        "qy", "qz", "qw"};
+    std::array<double, 8> v{};
+    for (std::size_t k = 0; k < 8; ++k) {
+      v[k] = parseNumberField(line.fields[k], path, line.line_number, kNames[k]);
+    }
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = rotationFromQuaternion(v[4], v[5], v[6], v[7]);
+    T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    by_time[v[0]] = T;
+  }
+  std::vector<TimedPose> poses;
+  poses.reserve(by_time.size());
+  for (const auto& [t, T] : by_time) poses.push_back({t, T});
+  return poses;
+}
+
+std::string formatTumPose(const TimedPose& pose) {
+  const Eigen::Vector3d t = pose.T_W_C.translation();
+  const Eigen::Quaterniond q(pose.T_W_C.linear());
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp_s,
+                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  return buffer;
+}
+
+void writeTrajectory(const std::string& path, const std::vector<TimedPose>& poses) {
+  std::string text = "# timestamp tx ty tz qx qy qz qw (camera to world)\n";
+  for (const TimedPose& pose : poses) {
+    text += formatTumPose(pose);
+    text += '\n';
+  }
+  writeTextFileAtomic(path, text);
+}
+
+}  // namespace dynamap
