@@ -1,0 +1,88 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/timing.hpp"
+#include "dynamap/mapping/map_backend.hpp"
+#include "dynamap/mapping/static_points.hpp"
+
+namespace dynamap {
+
+/// Runs a backend on its own thread behind a bounded queue of keyframe packets. Pose updates
+/// from bundle adjustment are forwarded to the backend; volumetric backends (kReintegrate) are
+/// rebuilt with the final poses in finish() when some keyframe moved by more than
+/// `kReintegrateTranslationM` / `kReintegrateRotationRad`. For that the worker keeps each
+/// keyframe's static depth (16-bit, 0.2 mm) and colour. All public methods are thread-safe;
+/// exportMap() and stats() after finish() see the final map.
+class MappingWorker {
+ public:
+  static constexpr double kReintegrateTranslationM = 0.01;
+  static constexpr double kReintegrateRotationRad = 0.5 * 3.14159265358979 / 180.0;
+
+  MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
+                const StaticPointsOptions& options, std::size_t queue_capacity,
+                TimingRecorder* timings);
+  ~MappingWorker();
+  MappingWorker(const MappingWorker&) = delete;
+  MappingWorker& operator=(const MappingWorker&) = delete;
+
+  /// Blocks while the queue is full.
+  void push(KeyframePacketPtr kf);
+  /// Non-blocking; returns false (and counts a drop) when the queue is full.
+  bool tryPush(KeyframePacketPtr kf);
+  void applyPoseUpdates(const std::vector<PoseUpdate>& updates);
+  /// Drains the queue, stops the thread, applies the final poses (rebuild if needed). Idempotent.
+  void finish();
+  void exportMap(const std::string& dir);
+  MapStats stats() const;
+  std::size_t droppedKeyframes() const { return dropped_.load(); }
+  /// Keyframes re-integrated by the final rebuild (0 if none was needed).
+  std::size_t reintegratedKeyframes() const;
+
+ private:
+  struct KeyframeRecord {
+    double timestamp_s = 0.0;
+    Eigen::Isometry3d T_integrated = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d T_current = Eigen::Isometry3d::Identity();
+    cv::Mat depth_u16;  ///< static depth, 1/5000 m
+    cv::Mat bgr;
+  };
+  void run();
+  void integratePacket(const KeyframePacket& kf);
+  void rebuildIfNeeded();
+  void applyUpdateLocked(const PoseUpdate& update);
+
+  std::unique_ptr<MapBackend> backend_;
+  PinholeCamera camera_;
+  StaticPointsOptions options_;
+  std::size_t capacity_;
+  TimingRecorder* timings_;
+
+  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, stopping_
+  std::condition_variable not_empty_;
+  std::condition_variable not_full_;
+  std::deque<KeyframePacketPtr> queue_;
+  std::vector<PoseUpdate> pending_updates_;
+  bool stopping_ = false;
+  bool finished_ = false;
+  std::atomic<std::size_t> dropped_{0};
+
+  mutable std::mutex backend_mutex_;  ///< guards backend_ and records_
+  std::unordered_map<std::uint64_t, KeyframeRecord> records_;
+  std::vector<std::uint64_t> order_;
+  std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
+  std::size_t reintegrated_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace dynamap

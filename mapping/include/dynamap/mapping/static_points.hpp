@@ -1,0 +1,43 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/camera.hpp"
+
+namespace dynamap {
+
+struct StaticPointsOptions {
+  double depth_min_m = 0.3;
+  double depth_max_m = 4.0;
+  int mask_dilation_px = 5;              ///< dynamic mask grown by this radius (0 = as is)
+  double depth_edge_threshold_m = 0.05;  ///< |depth jump| to a 4-neighbour marking an edge
+  int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
+};
+
+/// The static part of one RGB-D keyframe. The only place where masks become map input.
+struct StaticPoints {
+  cv::Mat static_depth_m;                           ///< CV_32FC1, 0 = dropped
+  std::vector<Eigen::Vector3f> points_C;            ///< camera frame
+  std::vector<std::array<std::uint8_t, 3>> colors;  ///< RGB, one per point
+};
+
+/// depth_m: CV_32FC1 metres (0 = none); bgr: CV_8UC3 or empty (grey points);
+/// dynamic_mask: CV_8UC1 with 255 = moving (any other value static), or empty.
+/// Drops masked pixels (after dilation), depths outside [min, max], and depth edges (pixels whose
+/// depth differs from a valid 4-neighbour by more than the threshold, i.e. mixed pixels).
+/// Thread-safe (pure function).
+StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr,
+                                 const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                 const StaticPointsOptions& options);
+
+/// Back-projects the non-zero pixels of an already filtered depth image (every `stride`-th pixel).
+void backProjectDepth(const PinholeCamera& camera, const cv::Mat& bgr, const cv::Mat& depth_m,
+                      int stride, std::vector<Eigen::Vector3f>* points_C,
+                      std::vector<std::array<std::uint8_t, 3>>* colors);
+
+}  // namespace dynamap

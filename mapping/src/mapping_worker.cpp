@@ -1,0 +1,199 @@
+#include "dynamap/mapping/mapping_worker.hpp"
+
+#include <chrono>
+#include <cmath>
+
+namespace dynamap {
+namespace {
+
+constexpr double kDepthUnitsPerM = 5000.0;
+
+bool movedBeyond(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double trans_m,
+                 double rot_rad) {
+  const Eigen::Isometry3d delta = a.inverse() * b;
+  const double angle = Eigen::AngleAxisd(delta.rotation()).angle();
+  return delta.translation().norm() > trans_m || std::fabs(angle) > rot_rad;
+}
+
+}  // namespace
+
+MappingWorker::MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
+                             const StaticPointsOptions& options, std::size_t queue_capacity,
+                             TimingRecorder* timings)
+    : backend_(std::move(backend)),
+      camera_(camera),
+      options_(options),
+      capacity_(std::max<std::size_t>(1, queue_capacity)),
+      timings_(timings) {
+  if (!backend_) throw MappingError("MappingWorker: null backend");
+  thread_ = std::thread([this] { run(); });
+}
+
+MappingWorker::~MappingWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  not_empty_.notify_all();
+  not_full_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void MappingWorker::push(KeyframePacketPtr kf) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  not_full_.wait(lock, [this] { return queue_.size() < capacity_ || stopping_; });
+  if (stopping_) return;
+  queue_.push_back(std::move(kf));
+  lock.unlock();
+  not_empty_.notify_one();
+}
+
+bool MappingWorker::tryPush(KeyframePacketPtr kf) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (stopping_ || queue_.size() >= capacity_) {
+    ++dropped_;
+    return false;
+  }
+  queue_.push_back(std::move(kf));
+  lock.unlock();
+  not_empty_.notify_one();
+  return true;
+}
+
+void MappingWorker::applyPoseUpdates(const std::vector<PoseUpdate>& updates) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_updates_.insert(pending_updates_.end(), updates.begin(), updates.end());
+  }
+  not_empty_.notify_one();
+}
+
+void MappingWorker::run() {
+  for (;;) {
+    KeyframePacketPtr kf;
+    std::vector<PoseUpdate> updates;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      not_empty_.wait(lock,
+                      [this] { return stopping_ || !queue_.empty() || !pending_updates_.empty(); });
+      if (!queue_.empty()) {
+        kf = std::move(queue_.front());
+        queue_.pop_front();
+      }
+      updates.swap(pending_updates_);
+      if (!kf && updates.empty() && stopping_) return;
+    }
+    not_full_.notify_all();
+    std::lock_guard<std::mutex> lock(backend_mutex_);
+    if (kf) integratePacket(*kf);
+    for (const auto& u : updates) applyUpdateLocked(u);
+  }
+}
+
+void MappingWorker::applyUpdateLocked(const PoseUpdate& update) {
+  auto it = records_.find(update.keyframe_id);
+  if (it == records_.end()) {  // the keyframe is still queued: apply when it is integrated
+    early_updates_[update.keyframe_id] = update.T_W_C;
+    return;
+  }
+  it->second.T_current = update.T_W_C;
+  backend_->updatePose(update.keyframe_id, update.T_W_C);
+}
+
+void MappingWorker::integratePacket(const KeyframePacket& kf) {
+  ScopedStageTimer timer(timings_, "mapping_integrate");
+  StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, kf.dynamic_mask, options_);
+  KeyframeView view;
+  view.id = kf.id;
+  view.timestamp_s = kf.timestamp_s;
+  view.T_W_C = kf.T_W_C;
+  view.camera = &camera_;
+  view.bgr = &kf.bgr;
+  view.static_depth_m = &sp.static_depth_m;
+  view.points_C = &sp.points_C;
+  view.colors = &sp.colors;
+  backend_->integrate(view);
+  KeyframeRecord rec;
+  rec.timestamp_s = kf.timestamp_s;
+  rec.T_integrated = kf.T_W_C;
+  rec.T_current = kf.T_W_C;
+  if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate) {
+    sp.static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
+    rec.bgr = kf.bgr;  // shared, immutable packet data
+  }
+  if (records_.emplace(kf.id, std::move(rec)).second) order_.push_back(kf.id);
+  const auto early = early_updates_.find(kf.id);
+  if (early != early_updates_.end()) {
+    const PoseUpdate update{kf.id, early->second};
+    early_updates_.erase(early);
+    applyUpdateLocked(update);
+  }
+}
+
+void MappingWorker::rebuildIfNeeded() {
+  if (backend_->poseUpdateMode() != PoseUpdateMode::kReintegrate) return;
+  bool moved = false;
+  for (const auto& kv : records_) {
+    moved = moved || movedBeyond(kv.second.T_integrated, kv.second.T_current,
+                                 kReintegrateTranslationM, kReintegrateRotationRad);
+  }
+  if (!moved) return;
+  ScopedStageTimer timer(timings_, "mapping_rebuild");
+  backend_->reset();
+  StaticPoints sp;
+  for (const std::uint64_t id : order_) {
+    KeyframeRecord& rec = records_.at(id);
+    rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
+    backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                     &sp.colors);
+    KeyframeView view;
+    view.id = id;
+    view.timestamp_s = rec.timestamp_s;
+    view.T_W_C = rec.T_current;
+    view.camera = &camera_;
+    view.bgr = &rec.bgr;
+    view.static_depth_m = &sp.static_depth_m;
+    view.points_C = &sp.points_C;
+    view.colors = &sp.colors;
+    backend_->integrate(view);
+    rec.T_integrated = rec.T_current;
+  }
+  reintegrated_ = order_.size();
+}
+
+void MappingWorker::finish() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (finished_) return;
+    finished_ = true;
+    stopping_ = true;
+  }
+  not_empty_.notify_all();
+  not_full_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  std::vector<PoseUpdate> late;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    late.swap(pending_updates_);  // arrived after the thread's last round
+  }
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  for (const auto& u : late) applyUpdateLocked(u);
+  rebuildIfNeeded();
+}
+
+void MappingWorker::exportMap(const std::string& dir) {
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  backend_->exportMap(dir);
+}
+
+MapStats MappingWorker::stats() const {
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  return backend_->stats();
+}
+
+std::size_t MappingWorker::reintegratedKeyframes() const {
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  return reintegrated_;
+}
+
+}  // namespace dynamap

@@ -1,0 +1,219 @@
+#include "dynamap/mapping/ply_io.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dynamap/mapping/map_backend.hpp"
+
+namespace dynamap {
+namespace {
+
+struct Property {
+  std::string name;
+  std::string type;        // scalar type, or the list's item type
+  std::string count_type;  // non-empty for list properties
+};
+struct Element {
+  std::string name;
+  std::size_t count = 0;
+  std::vector<Property> props;
+};
+
+std::size_t typeSize(const std::string& t, const std::string& path) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
+    return 4;
+  if (t == "double" || t == "float64") return 8;
+  throw MappingError(path + ": unknown PLY type '" + t + "'");
+}
+
+double readBinary(std::istream& in, const std::string& t, const std::string& path) {
+  char buf[8];
+  const std::size_t n = typeSize(t, path);
+  if (!in.read(buf, static_cast<std::streamsize>(n))) {
+    throw MappingError(path + ": truncated PLY data");
+  }
+  auto as = [&](auto v) {
+    std::memcpy(&v, buf, sizeof(v));
+    return static_cast<double>(v);
+  };
+  if (t == "char" || t == "int8") return as(std::int8_t{});
+  if (t == "uchar" || t == "uint8") return as(std::uint8_t{});
+  if (t == "short" || t == "int16") return as(std::int16_t{});
+  if (t == "ushort" || t == "uint16") return as(std::uint16_t{});
+  if (t == "int" || t == "int32") return as(std::int32_t{});
+  if (t == "uint" || t == "uint32") return as(std::uint32_t{});
+  if (t == "float" || t == "float32") return as(float{});
+  return as(double{});
+}
+
+std::vector<Element> readHeader(std::istream& in, const std::string& path, bool* binary) {
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
+    throw MappingError(path + ": not a PLY file");
+  }
+  std::vector<Element> elements;
+  *binary = false;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream ls(line);
+    std::string word;
+    ls >> word;
+    if (word == "format") {
+      std::string fmt;
+      ls >> fmt;
+      if (fmt == "binary_little_endian") {
+        *binary = true;
+      } else if (fmt != "ascii") {
+        throw MappingError(path + ": unsupported PLY format '" + fmt + "'");
+      }
+    } else if (word == "element") {
+      Element e;
+      ls >> e.name >> e.count;
+      elements.push_back(e);
+    } else if (word == "property" && !elements.empty()) {
+      Property p;
+      std::string t;
+      ls >> t;
+      if (t == "list") {
+        ls >> p.count_type >> p.type >> p.name;
+      } else {
+        p.type = t;
+        ls >> p.name;
+      }
+      elements.back().props.push_back(p);
+    } else if (word == "end_header") {
+      return elements;
+    }
+  }
+  throw MappingError(path + ": PLY header without end_header");
+}
+
+}  // namespace
+
+PlyData readPly(const std::string& path, bool with_faces) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MappingError(path + ": cannot open PLY file");
+  bool binary = false;
+  const std::vector<Element> elements = readHeader(in, path, &binary);
+  PlyData data;
+  for (const Element& e : elements) {
+    const bool is_vertex = e.name == "vertex";
+    const bool is_face = e.name == "face" && with_faces;
+    int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      const std::string& n = e.props[k].name;
+      const int ki = static_cast<int>(k);
+      if (n == "x") ix = ki;
+      if (n == "y") iy = ki;
+      if (n == "z") iz = ki;
+      if (n == "red" || n == "r") ir = ki;
+      if (n == "green" || n == "g") ig = ki;
+      if (n == "blue" || n == "b") ib = ki;
+    }
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) {
+      throw MappingError(path + ": PLY vertices without x, y, z");
+    }
+    const bool colours = is_vertex && ir >= 0 && ig >= 0 && ib >= 0;
+    if (is_vertex) data.vertices.reserve(e.count);
+    std::vector<double> values(e.props.size());
+    std::vector<double> list;
+    for (std::size_t i = 0; i < e.count; ++i) {
+      for (std::size_t k = 0; k < e.props.size(); ++k) {
+        const Property& p = e.props[k];
+        if (p.count_type.empty()) {
+          if (binary) {
+            values[k] = readBinary(in, p.type, path);
+          } else if (!(in >> values[k])) {
+            throw MappingError(path + ": truncated PLY data");
+          }
+          continue;
+        }
+        double n = 0;
+        if (binary) {
+          n = readBinary(in, p.count_type, path);
+        } else if (!(in >> n)) {
+          throw MappingError(path + ": truncated PLY data");
+        }
+        list.resize(static_cast<std::size_t>(n));
+        for (double& v : list) {
+          if (binary) {
+            v = readBinary(in, p.type, path);
+          } else if (!(in >> v)) {
+            throw MappingError(path + ": truncated PLY data");
+          }
+        }
+        if (is_face) {
+          for (std::size_t t = 1; t + 1 < list.size(); ++t) {  // fan-triangulate polygons
+            data.triangles.push_back({static_cast<std::uint32_t>(list[0]),
+                                      static_cast<std::uint32_t>(list[t]),
+                                      static_cast<std::uint32_t>(list[t + 1])});
+          }
+        }
+      }
+      if (is_vertex) {
+        data.vertices.emplace_back(values[ix], values[iy], values[iz]);
+        if (colours) {
+          data.colors.push_back({static_cast<std::uint8_t>(values[ir]),
+                                 static_cast<std::uint8_t>(values[ig]),
+                                 static_cast<std::uint8_t>(values[ib])});
+        }
+      }
+    }
+  }
+  return data;
+}
+
+void writePly(const std::string& path, const PlyData& data) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw MappingError(path + ": cannot write PLY file");
+  const bool colours = !data.colors.empty() && data.colors.size() == data.vertices.size();
+  out << "ply\nformat binary_little_endian 1.0\ncomment dynamap\n"
+      << "element vertex " << data.vertices.size() << "\n"
+      << "property float x\nproperty float y\nproperty float z\n";
+  if (colours) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!data.triangles.empty()) {
+    out << "element face " << data.triangles.size() << "\n"
+        << "property list uchar int vertex_indices\n";
+  }
+  out << "end_header\n";
+  for (std::size_t i = 0; i < data.vertices.size(); ++i) {
+    out.write(reinterpret_cast<const char*>(data.vertices[i].data()), 3 * sizeof(float));
+    if (colours) out.write(reinterpret_cast<const char*>(data.colors[i].data()), 3);
+  }
+  for (const auto& t : data.triangles) {
+    const std::uint8_t n = 3;
+    out.write(reinterpret_cast<const char*>(&n), 1);
+    const std::int32_t idx[3] = {static_cast<std::int32_t>(t[0]), static_cast<std::int32_t>(t[1]),
+                                 static_cast<std::int32_t>(t[2])};
+    out.write(reinterpret_cast<const char*>(idx), sizeof(idx));
+  }
+  if (!out) throw MappingError(path + ": write failed");
+}
+
+void writeAtomically(const std::string& final_path,
+                     const std::function<void(const std::string& tmp_path)>& write) {
+  namespace fs = std::filesystem;
+  const fs::path target(final_path);
+  std::error_code ec;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  const fs::path tmp = target.parent_path() /
+                       ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
+  try {
+    write(tmp.string());
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+  if (!fs::exists(tmp, ec)) throw MappingError(final_path + ": writer produced no file");
+  fs::rename(tmp, target, ec);
+  if (ec) throw MappingError(final_path + ": rename failed: " + ec.message());
+}
+
+}  // namespace dynamap

@@ -1,0 +1,42 @@
+#pragma once
+
+// PCL export shared by the point-cloud backends (header-only, compiled into each plugin).
+
+#include <filesystem>
+#include <string>
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "dynamap/mapping/map_backend.hpp"
+#include "dynamap/mapping/ply_io.hpp"
+
+namespace dynamap::plugin {
+
+/// Writes <dir>/cloud.ply and <dir>/cloud.pcd (binary), each atomically.
+inline void saveCloudPlyPcd(const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
+                            const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const std::string base = (std::filesystem::path(dir) / "cloud").string();
+  writeAtomically(base + ".ply", [&](const std::string& tmp) {
+    if (pcl::io::savePLYFileBinary(tmp, cloud) != 0) throw MappingError(tmp + ": PLY write failed");
+  });
+  writeAtomically(base + ".pcd", [&](const std::string& tmp) {
+    if (pcl::io::savePCDFileBinary(tmp, cloud) != 0) throw MappingError(tmp + ": PCD write failed");
+  });
+}
+
+inline pcl::PointXYZRGB makePoint(const Eigen::Vector3f& p, const std::array<std::uint8_t, 3>& c) {
+  pcl::PointXYZRGB q;
+  q.x = p.x();
+  q.y = p.y();
+  q.z = p.z();
+  q.r = c[0];
+  q.g = c[1];
+  q.b = c[2];
+  return q;
+}
+
+}  // namespace dynamap::plugin

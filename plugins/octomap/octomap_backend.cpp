@@ -1,0 +1,138 @@
+// `octomap`: occupancy octree with ray casting from the camera centre (free space clears
+// ghosts). Fast path: each keyframe's points are reduced to the centres of the distinct voxels
+// they hit before ray casting (lazy evaluation; inner nodes are updated at export).
+// Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres).
+#include <filesystem>
+#include <unordered_set>
+
+#include <octomap/OcTree.h>
+
+#include "dynamap/mapping/backend_params.hpp"
+#include "dynamap/mapping/plugin_api.hpp"
+#include "dynamap/mapping/ply_io.hpp"
+#include "occupancy_grid.hpp"
+
+namespace dynamap {
+namespace {
+
+class OctomapBackend final : public MapBackend {
+ public:
+  explicit OctomapBackend(const BackendParams& params) : tree_(0.05) {
+    ParamReader reader("octomap", params);
+    const double res = reader.getDouble("resolution_m", 0.05, 0.005, 10.0);
+    max_range_m_ = reader.getDouble("max_range_m", -1.0, -1.0, 1000.0);
+    discretize_ = reader.getBool("discretize", true);
+    const double hit = reader.getDouble("prob_hit", 0.7, 0.5, 1.0);
+    const double miss = reader.getDouble("prob_miss", 0.4, 0.0, 0.5);
+    const double cmin = reader.getDouble("clamp_min", 0.12, 0.0, 0.5);
+    const double cmax = reader.getDouble("clamp_max", 0.97, 0.5, 1.0);
+    const std::string up = reader.getString("up_axis", "z", {"x", "y", "z", "-x", "-y", "-z"});
+    grid_.up_sign = up[0] == '-' ? -1 : 1;
+    grid_.up_axis = up.back() - 'x';
+    grid_.min_height_m = reader.getDouble("grid_min_height_m", 0.1, -1e4, 1e4);
+    grid_.max_height_m = reader.getDouble("grid_max_height_m", 2.0, -1e4, 1e4);
+    reader.finish();
+    tree_.setResolution(res);
+    tree_.setProbHit(hit);
+    tree_.setProbMiss(miss);
+    tree_.setClampingThresMin(cmin);
+    tree_.setClampingThresMax(cmax);
+  }
+
+  void integrate(const KeyframeView& view) override {
+    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
+    const Eigen::Vector3d o = view.T_W_C.translation();
+    octomap::Pointcloud cloud;
+    cloud.reserve(view.points_C->size());
+    if (discretize_) {
+      octomap::KeySet seen;
+      for (const auto& p_C : *view.points_C) {
+        const Eigen::Vector3f p = T * p_C;
+        octomap::OcTreeKey key;
+        if (!tree_.coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
+        if (seen.insert(key).second) cloud.push_back(tree_.keyToCoord(key));
+      }
+    } else {
+      for (const auto& p_C : *view.points_C) {
+        const Eigen::Vector3f p = T * p_C;
+        cloud.push_back(p.x(), p.y(), p.z());
+      }
+    }
+    tree_.insertPointCloud(cloud, octomap::point3d(o.x(), o.y(), o.z()), max_range_m_,
+                           /*lazy_eval=*/true, /*discretize=*/false);
+    dirty_inner_ = true;
+    ++keyframes_;
+  }
+
+  void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
+  PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
+  void reset() override {
+    tree_.clear();
+    keyframes_ = 0;
+  }
+
+  void exportMap(const std::string& dir) override {
+    namespace fs = std::filesystem;
+    fs::create_directories(dir);
+    finalizeTree();
+    const fs::path d(dir);
+    writeAtomically((d / "map.bt").string(), [&](const std::string& tmp) {
+      if (!tree_.writeBinaryConst(tmp)) throw MappingError(tmp + ": OctoMap write failed");
+    });
+    writeAtomically((d / "map.ot").string(), [&](const std::string& tmp) {
+      if (!tree_.write(tmp)) throw MappingError(tmp + ": OctoMap write failed");
+    });
+    plugin::writeOccupancyGrid(tree_, grid_, dir);
+    PlyData cloud;
+    cloud.vertices = occupiedCentres();
+    writeAtomically((d / "cloud.ply").string(),
+                    [&](const std::string& tmp) { writePly(tmp, cloud); });
+  }
+
+  MapStats stats() const override {
+    MapStats s;
+    s.keyframes = keyframes_;
+    for (auto it = tree_.begin_leafs(), end = tree_.end_leafs(); it != end; ++it) {
+      if (tree_.isNodeOccupied(*it)) ++s.elements;
+    }
+    s.memory_bytes = tree_.memoryUsage();
+    s.element_kind = "occupied_cells";
+    return s;
+  }
+
+ private:
+  void finalizeTree() {
+    if (dirty_inner_) tree_.updateInnerOccupancy();
+    dirty_inner_ = false;
+  }
+
+  // Centres of the occupied finest-level voxels (pruned nodes expanded).
+  std::vector<Eigen::Vector3f> occupiedCentres() const {
+    std::vector<Eigen::Vector3f> out;
+    const double res = tree_.getResolution();
+    const unsigned max_depth = tree_.getTreeDepth();
+    for (auto it = tree_.begin_leafs(), end = tree_.end_leafs(); it != end; ++it) {
+      if (!tree_.isNodeOccupied(*it)) continue;
+      const int n = 1 << (max_depth - it.getDepth());
+      const octomap::point3d c = it.getCoordinate();
+      const double h = it.getSize() / 2 - res / 2;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          for (int k = 0; k < n; ++k)
+            out.emplace_back(c.x() - h + i * res, c.y() - h + j * res, c.z() - h + k * res);
+    }
+    return out;
+  }
+
+  octomap::OcTree tree_;
+  double max_range_m_ = -1.0;
+  bool discretize_ = true;
+  plugin::GridOptions grid_;
+  std::size_t keyframes_ = 0;
+  bool dirty_inner_ = false;
+};
+
+}  // namespace
+}  // namespace dynamap
+
+DYNAMAP_DEFINE_BACKEND(dynamap::OctomapBackend)

@@ -1,0 +1,81 @@
+// `points`: raw stitching of keyframe clouds. Keeps each keyframe's static points in the camera
+// frame, so pose updates only change the stored pose; export transforms and concatenates.
+#include <unordered_map>
+
+#include "dynamap/mapping/backend_params.hpp"
+#include "dynamap/mapping/plugin_api.hpp"
+#include "pcl_cloud_io.hpp"
+
+namespace dynamap {
+namespace {
+
+class PointsBackend final : public MapBackend {
+ public:
+  explicit PointsBackend(const BackendParams& params) {
+    ParamReader reader("points", params);
+    keep_every_ = reader.getInt("keep_every", 1, 1, 1000);
+    reader.finish();
+  }
+
+  void integrate(const KeyframeView& view) override {
+    Keyframe kf;
+    kf.T_W_C = view.T_W_C;
+    const auto& pts = *view.points_C;
+    for (std::size_t i = 0; i < pts.size(); i += static_cast<std::size_t>(keep_every_)) {
+      kf.points_C.push_back(pts[i]);
+      kf.colors.push_back((*view.colors)[i]);
+    }
+    total_points_ += kf.points_C.size();
+    auto [it, inserted] = keyframes_.emplace(view.id, std::move(kf));
+    if (inserted) order_.push_back(view.id);
+  }
+
+  void updatePose(std::uint64_t keyframe_id, const Eigen::Isometry3d& T_W_C) override {
+    auto it = keyframes_.find(keyframe_id);
+    if (it != keyframes_.end()) it->second.T_W_C = T_W_C;
+  }
+  PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kInPlace; }
+  void reset() override {
+    keyframes_.clear();
+    order_.clear();
+    total_points_ = 0;
+  }
+
+  void exportMap(const std::string& dir) override {
+    pcl::PointCloud<pcl::PointXYZRGB> cloud;
+    cloud.reserve(total_points_);
+    for (const std::uint64_t id : order_) {
+      const Keyframe& kf = keyframes_.at(id);
+      const Eigen::Isometry3f T = kf.T_W_C.cast<float>();
+      for (std::size_t i = 0; i < kf.points_C.size(); ++i) {
+        cloud.push_back(plugin::makePoint(T * kf.points_C[i], kf.colors[i]));
+      }
+    }
+    plugin::saveCloudPlyPcd(cloud, dir);
+  }
+
+  MapStats stats() const override {
+    MapStats s;
+    s.keyframes = keyframes_.size();
+    s.elements = total_points_;
+    s.memory_bytes = total_points_ * (sizeof(Eigen::Vector3f) + 3);
+    s.element_kind = "points";
+    return s;
+  }
+
+ private:
+  struct Keyframe {
+    Eigen::Isometry3d T_W_C;
+    std::vector<Eigen::Vector3f> points_C;
+    std::vector<std::array<std::uint8_t, 3>> colors;
+  };
+  int keep_every_ = 1;
+  std::unordered_map<std::uint64_t, Keyframe> keyframes_;
+  std::vector<std::uint64_t> order_;
+  std::size_t total_points_ = 0;
+};
+
+}  // namespace
+}  // namespace dynamap
+
+DYNAMAP_DEFINE_BACKEND(dynamap::PointsBackend)

@@ -1,0 +1,193 @@
+#include "tsdf_volume.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <openvdb/io/File.h>
+#include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+namespace dynamap::plugin {
+namespace {
+
+constexpr int kLeafDim = 8;  // openvdb::FloatTree::LeafNodeType::DIM
+
+using Key = std::uint64_t;
+Key packLeaf(const openvdb::Coord& c) {
+  constexpr std::int64_t kOffset = 1 << 20;
+  constexpr std::uint64_t kMask = (1u << 21) - 1;
+  return (std::uint64_t(c.x() / kLeafDim + kOffset) & kMask) |
+         ((std::uint64_t(c.y() / kLeafDim + kOffset) & kMask) << 21) |
+         ((std::uint64_t(c.z() / kLeafDim + kOffset) & kMask) << 42);
+}
+openvdb::Coord unpackLeaf(Key k) {
+  constexpr std::int64_t kOffset = 1 << 20;
+  constexpr std::uint64_t kMask = (1u << 21) - 1;
+  return openvdb::Coord(int((std::int64_t(k & kMask) - kOffset) * kLeafDim),
+                        int((std::int64_t((k >> 21) & kMask) - kOffset) * kLeafDim),
+                        int((std::int64_t((k >> 42) & kMask) - kOffset) * kLeafDim));
+}
+// Origin of the leaf holding world point p.
+openvdb::Coord leafOf(const Eigen::Vector3d& p_W, double inv_voxel) {
+  const auto idx = [&](double v) {
+    const int i = static_cast<int>(std::lround(v * inv_voxel));
+    return i & ~(kLeafDim - 1);
+  };
+  return openvdb::Coord(idx(p_W.x()), idx(p_W.y()), idx(p_W.z()));
+}
+
+}  // namespace
+
+TsdfVolume::TsdfVolume(const TsdfOptions& options) : options_(options) {
+  openvdb::initialize();  // idempotent, registers grid types for I/O
+  reset();
+}
+
+void TsdfVolume::reset() {
+  const auto transform = openvdb::math::Transform::createLinearTransform(options_.voxel_size_m);
+  tsdf_ = openvdb::FloatGrid::create(1.0f);
+  tsdf_->setTransform(transform);
+  tsdf_->setName("tsdf");
+  tsdf_->setGridClass(openvdb::GRID_LEVEL_SET);
+  weight_ = openvdb::FloatGrid::create(0.0f);
+  weight_->setTransform(transform->copy());
+  weight_->setName("weight");
+  color_ = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  color_->setTransform(transform->copy());
+  color_->setName("color");
+}
+
+std::vector<openvdb::Coord> TsdfVolume::collectBlocks(const PinholeCamera& camera,
+                                                      const cv::Mat& depth_m,
+                                                      const Eigen::Isometry3d& T_W_C) const {
+  const double inv_voxel = 1.0 / options_.voxel_size_m;
+  const double trunc = options_.truncation_m;
+  const double leaf_m = kLeafDim * options_.voxel_size_m;
+  const int stride = std::max(1, options_.alloc_stride_px);
+  const int carve = options_.space_carving ? std::max(1, options_.carve_stride_px) : 0;
+  const Eigen::Vector3d origin = T_W_C.translation();
+  tbb::combinable<std::vector<Key>> keys;
+  tbb::parallel_for(tbb::blocked_range<int>(0, depth_m.rows), [&](const auto& range) {
+    std::vector<Key>& out = keys.local();
+    auto add = [&](const Eigen::Vector3d& p_W) {
+      const Key k = packLeaf(leafOf(p_W, inv_voxel));
+      if (out.empty() || out.back() != k) out.push_back(k);
+    };
+    const auto tree = tsdf_->getConstAccessor();
+    for (int r = range.begin(); r < range.end(); ++r) {
+      if (r % stride != 0 && (carve == 0 || r % carve != 0)) continue;
+      const float* row = depth_m.ptr<float>(r);
+      for (int c = 0; c < depth_m.cols; ++c) {
+        const float z = row[c];
+        if (!(z > 0.0f)) continue;
+        const Eigen::Vector3d p_W = T_W_C * camera.backProject(c, r, z);
+        const Eigen::Vector3d dir = (p_W - origin) / (p_W - origin).norm();
+        if (r % stride == 0 && c % stride == 0) {
+          add(p_W - trunc * dir);
+          add(p_W);
+          add(p_W + trunc * dir);
+        }
+        if (carve > 0 && r % carve == 0 && c % carve == 0) {
+          // Existing blocks in front of the surface: stale surfaces get carved away.
+          const double free_len = (p_W - origin).norm() - trunc;
+          for (double s = 0.5 * leaf_m; s < free_len; s += 0.5 * leaf_m) {
+            const openvdb::Coord leaf = leafOf(origin + s * dir, inv_voxel);
+            if (tree.probeConstLeaf(leaf) != nullptr) {
+              const Key k = packLeaf(leaf);
+              if (out.empty() || out.back() != k) out.push_back(k);
+            }
+          }
+        }
+      }
+    }
+  });
+  std::vector<Key> all;
+  keys.combine_each([&](const std::vector<Key>& v) { all.insert(all.end(), v.begin(), v.end()); });
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  std::vector<openvdb::Coord> blocks;
+  blocks.reserve(all.size());
+  for (const Key k : all) blocks.push_back(unpackLeaf(k));
+  return blocks;
+}
+
+void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
+                           const Eigen::Isometry3d& T_W_C) {
+  const std::vector<openvdb::Coord> blocks = collectBlocks(camera, depth_m, T_W_C);
+  using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+  using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
+  std::vector<FloatLeaf*> tsdf_leaves(blocks.size());
+  std::vector<FloatLeaf*> weight_leaves(blocks.size());
+  std::vector<ColorLeaf*> color_leaves(blocks.size());
+  {
+    auto ta = tsdf_->getAccessor();
+    auto wa = weight_->getAccessor();
+    auto ca = color_->getAccessor();
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      tsdf_leaves[i] = ta.touchLeaf(blocks[i]);
+      weight_leaves[i] = wa.touchLeaf(blocks[i]);
+      color_leaves[i] = ca.touchLeaf(blocks[i]);
+    }
+  }
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  const Eigen::Matrix3f R = T_C_W.rotation().cast<float>();
+  const Eigen::Vector3f t = T_C_W.translation().cast<float>();
+  const auto vs = static_cast<float>(options_.voxel_size_m);
+  const auto trunc = static_cast<float>(options_.truncation_m);
+  const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const bool has_colour = !bgr.empty() && bgr.size() == depth_m.size();
+  const Eigen::Vector3f step_z = R.col(2) * vs;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b < range.end(); ++b) {
+      FloatLeaf& tl = *tsdf_leaves[b];
+      FloatLeaf& wl = *weight_leaves[b];
+      ColorLeaf& cl = *color_leaves[b];
+      const openvdb::Coord o = blocks[b];
+      for (int x = 0; x < kLeafDim; ++x) {
+        for (int y = 0; y < kLeafDim; ++y) {
+          Eigen::Vector3f p_C = R * (Eigen::Vector3f(o.x() + x, o.y() + y, o.z()) * vs) + t;
+          for (int z = 0; z < kLeafDim; ++z, p_C += step_z) {
+            if (p_C.z() <= 0.05f) continue;
+            const float inv_z = 1.0f / p_C.z();
+            const int u = static_cast<int>(fx * p_C.x() * inv_z + cx + 0.5f);
+            const int v = static_cast<int>(fy * p_C.y() * inv_z + cy + 0.5f);
+            if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+            const float d = depth_m.at<float>(v, u);
+            if (!(d > 0.0f)) continue;
+            const float sdf = d - p_C.z();
+            if (sdf < -trunc) continue;
+            const openvdb::Index n = (x << 6) | (y << 3) | z;
+            const float w_old = wl.getValue(n);
+            const float obs = std::min(1.0f, sdf / trunc);
+            float w = 1.0f;
+            if (options_.linear_weighting && sdf < 0.0f) w = std::max(0.05f, 1.0f + sdf / trunc);
+            const float w_new = std::min(w_old + w, options_.max_weight);
+            tl.setValueOn(n, (tl.getValue(n) * w_old + obs * w) / (w_old + w));
+            wl.setValueOn(n, w_new);
+            if (has_colour && std::fabs(sdf) < trunc) {
+              const cv::Vec3b p = bgr.at<cv::Vec3b>(v, u);
+              const openvdb::Vec3s c_new(p[2], p[1], p[0]);
+              cl.setValueOn(n, (cl.getValue(n) * w_old + c_new * w) / (w_old + w));
+            }
+          }
+        }
+      }
+    }
+  });
+}
+
+std::size_t TsdfVolume::memoryBytes() const {
+  return tsdf_->memUsage() + weight_->memUsage() + color_->memUsage();
+}
+
+void TsdfVolume::writeVdb(const std::string& path) const {
+  openvdb::GridPtrVec grids{tsdf_, weight_, color_};
+  openvdb::io::File file(path);
+  file.write(grids);
+  file.close();
+}
+
+}  // namespace dynamap::plugin

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/camera.hpp"
+#include "dynamap/mapping/ply_io.hpp"
+
+namespace dynamap::plugin {
+
+struct TsdfOptions {
+  double voxel_size_m = 0.02;
+  double truncation_m = 0.08;
+  float max_weight = 100.0f;
+  float min_weight = 1.0f;       ///< export: every corner of a mesh cell needs this weight
+  bool space_carving = true;     ///< visit existing blocks in front of the surface
+  bool linear_weighting = true;  ///< weight falls off linearly behind the surface
+  int alloc_stride_px = 2;       ///< pixel step when finding the blocks around the surface
+  int carve_stride_px = 8;       ///< pixel step of the rays looking for stale blocks
+};
+
+/// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight, colour), integrated
+/// projectively: the 8^3 leaf blocks within the truncation band of the observed depth (and, with
+/// space carving, existing blocks along the rays in front of it) are found from the depth image,
+/// then every voxel of those blocks is projected into the depth image (TBB over blocks).
+/// Not thread-safe.
+class TsdfVolume {
+ public:
+  explicit TsdfVolume(const TsdfOptions& options);
+  void integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
+                 const Eigen::Isometry3d& T_W_C);
+  void reset();
+  /// Marching cubes (openvdb::tools::volumeToMesh) keeping cells whose 8 corners are observed.
+  PlyData extractMesh() const;
+  void writeVdb(const std::string& path) const;
+  std::size_t activeVoxels() const { return tsdf_->activeVoxelCount(); }
+  std::size_t memoryBytes() const;
+
+ private:
+  std::vector<openvdb::Coord> collectBlocks(const PinholeCamera& camera, const cv::Mat& depth_m,
+                                            const Eigen::Isometry3d& T_W_C) const;
+  TsdfOptions options_;
+  openvdb::FloatGrid::Ptr tsdf_;
+  openvdb::FloatGrid::Ptr weight_;
+  openvdb::Vec3SGrid::Ptr color_;
+};
+
+}  // namespace dynamap::plugin
