@@ -77,7 +77,8 @@ Eigen::Isometry3d relativeError(const Eigen::Isometry3d& E_i, const Eigen::Isome
 
 std::string formatRow(const char* name, double value, const char* unit) {
   char buffer[128];
-  std::snprintf(buffer, sizeof(buffer), "  %-14s %12.6f %s\n", name, value, unit);
+  std::snprintf(buffer, sizeof(buffer), "  %-14s %12.6f%s%s\n", name, value, *unit ? " " : "",
+                unit);
   return buffer;
 }
 
