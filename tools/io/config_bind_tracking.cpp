@@ -4,11 +4,46 @@ namespace dynamap {
 
 void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.orb_features", &c.orb_features, 50, 20000);
+  schema.addInt("tracking.orb_levels", &c.orb_levels, 1, 16);
+  schema.addDouble("tracking.orb_scale_factor", &c.orb_scale_factor, 1.01, 2.0);
+  schema.addInt("tracking.orb_fast_threshold", &c.orb_fast_threshold, 1, 100);
+  schema.addInt("tracking.grid_cell_px", &c.grid_cell_px, 4, 320);
+  schema.addInt("tracking.min_tracked_features", &c.min_tracked_features, 10, 5000);
+
   schema.addInt("tracking.lk_levels", &c.lk_levels, 1, 10);
   schema.addDouble("tracking.lk_scale", &c.lk_scale, 0.5, 0.5);  // OpenCV's LK pyramid is fixed 0.5
+  schema.addInt("tracking.lk_window_px", &c.lk_window_px, 5, 63);
+  schema.addInt("tracking.lk_max_iterations", &c.lk_max_iterations, 1, 200);
+  schema.addDouble("tracking.lk_fb_threshold_px", &c.lk_fb_threshold_px, 0.01, 20.0);
+
   schema.addDouble("tracking.depth_min_m", &c.depth_min_m, 0.0, 100.0);
   schema.addDouble("tracking.depth_max_m", &c.depth_max_m, 0.0, 100.0);
+  schema.addDouble("tracking.landmark_depth_max_m", &c.landmark_depth_max_m, 0.1, 100.0);
+  schema.addDouble("tracking.depth_sigma_coeff", &c.depth_sigma_coeff, 1e-5, 1.0);
+  schema.addDouble("tracking.pixel_sigma_px", &c.pixel_sigma_px, 0.05, 20.0);
+
+  schema.addInt("tracking.pnp_ransac_iterations", &c.pnp_ransac_iterations, 1, 10000);
+  schema.addDouble("tracking.pnp_reprojection_px", &c.pnp_reprojection_px, 0.1, 50.0);
+  schema.addInt("tracking.min_inliers", &c.min_inliers, 4, 1000);
+  schema.addInt("tracking.refine_iterations", &c.refine_iterations, 0, 200);
+  schema.addDouble("tracking.robust_loss_sigma", &c.robust_loss_sigma, 0.1, 100.0);
+  schema.addBool("tracking.use_depth_residual", &c.use_depth_residual);
+
+  schema.addDouble("tracking.kf_min_tracked_ratio", &c.kf_min_tracked_ratio, 0.0, 1.0);
+  schema.addDouble("tracking.kf_max_translation_m", &c.kf_max_translation_m, 0.001, 100.0);
+  schema.addDouble("tracking.kf_max_rotation_deg", &c.kf_max_rotation_deg, 0.1, 180.0);
+  schema.addDouble("tracking.kf_max_parallax_px", &c.kf_max_parallax_px, 1.0, 1000.0);
+  schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
+
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
+  schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
+  schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
+  schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
+
+  schema.addInt("tracking.reloc_keyframes", &c.reloc_keyframes, 1, 10000);
+  schema.addInt("tracking.reloc_max_hamming", &c.reloc_max_hamming, 1, 256);
+  schema.addDouble("tracking.reloc_ratio", &c.reloc_ratio, 0.1, 1.0);
+  schema.addInt("tracking.reloc_min_inliers", &c.reloc_min_inliers, 4, 1000);
 }
 
 }  // namespace dynamap

@@ -5,12 +5,54 @@ namespace dynamap {
 /// Tracking front-end parameters. Defaults live here; tools/ binds them to YAML keys
 /// "tracking.<name>" (tools/io/config_bind_tracking.cpp).
 struct TrackerConfig {
-  int orb_features = 1000;   ///< ORB keypoints extracted per (key)frame
-  int lk_levels = 6;         ///< pyramid levels of Lucas-Kanade optical flow
-  double lk_scale = 0.5;     ///< scale between pyramid levels
+  // --- features (ORB over a scale pyramid, spread over a grid) ---
+  int orb_features = 1000;         ///< ORB keypoints extracted per (key)frame before gridding
+  int orb_levels = 8;              ///< ORB scale-pyramid levels
+  double orb_scale_factor = 1.2;   ///< ORB scale between levels
+  int orb_fast_threshold = 12;     ///< FAST threshold of the ORB detector
+  int grid_cell_px = 32;           ///< spatial grid cell; the best keypoint per cell is kept
+  int min_tracked_features = 150;  ///< fewer tracked features -> new keyframe + re-detection
+
+  // --- Lucas-Kanade frame-to-frame matching ---
+  int lk_levels = 6;                ///< pyramid levels of Lucas-Kanade optical flow
+  double lk_scale = 0.5;            ///< scale between pyramid levels
+  int lk_window_px = 21;            ///< LK window side
+  int lk_max_iterations = 30;       ///< LK iterations per level
+  double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
+
+  // --- depth ---
   double depth_min_m = 0.1;  ///< depth readings outside [min, max] are ignored
   double depth_max_m = 6.0;
+  double landmark_depth_max_m = 4.5;  ///< new landmarks only from depth below this
+  double depth_sigma_coeff = 0.0025;  ///< depth std-dev model sigma_z = coeff * z^2 (metres)
+  double pixel_sigma_px = 1.0;        ///< feature position std-dev
+
+  // --- pose estimation ---
+  int pnp_ransac_iterations = 100;
+  double pnp_reprojection_px = 3.0;  ///< RANSAC inlier threshold
+  int min_inliers = 15;              ///< fewer pose inliers -> frame is lost
+  int refine_iterations = 10;        ///< Ceres iterations of the motion-only refinement
+  double robust_loss_sigma = 2.8;    ///< Huber threshold on whitened residuals (sigma units)
+  bool use_depth_residual = true;    ///< add a depth residual to the reprojection residual
+
+  // --- keyframe policy: a keyframe when any of these holds ---
+  double kf_min_tracked_ratio = 0.6;   ///< tracked / landmarks seen by the reference keyframe
+  double kf_max_translation_m = 0.08;  ///< camera moved farther than this from the reference
+  double kf_max_rotation_deg = 8.0;    ///< camera rotated more than this from the reference
+  double kf_max_parallax_px = 40.0;    ///< median feature displacement since the reference
+  double kf_max_interval_s = 1.0;      ///< time since the reference keyframe
+
+  // --- local bundle adjustment (own thread) ---
   bool bundle_adjustment = true;  ///< local BA on its own thread
+  int ba_window = 8;              ///< keyframes optimised together
+  int ba_fixed_keyframes = 1;     ///< oldest keyframes of the window held fixed (gauge)
+  int ba_max_iterations = 10;
+
+  // --- relocalization ---
+  int reloc_keyframes = 30;    ///< newest keyframes whose landmarks are matched
+  int reloc_max_hamming = 64;  ///< ORB descriptor distance gate
+  double reloc_ratio = 0.8;    ///< Lowe ratio test
+  int reloc_min_inliers = 25;  ///< inliers needed to accept a relocalization
 };
 
 }  // namespace dynamap

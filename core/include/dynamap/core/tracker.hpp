@@ -1,0 +1,81 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/camera.hpp"
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/motion_filter.hpp"
+#include "dynamap/core/timing.hpp"
+#include "dynamap/core/tracker_config.hpp"
+
+namespace dynamap {
+
+/// Outcome of Tracker::track() for one frame.
+struct TrackingResult {
+  FrameStatus status = FrameStatus::kLost;
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  bool is_keyframe = false;
+  KeyframePacketPtr keyframe;  ///< set iff is_keyframe
+  int tracked_features = 0;    ///< LK matches kept
+  int inliers = 0;             ///< pose inliers
+  int dynamic_matches = 0;     ///< matches the motion filter rejected
+  cv::Mat dynamic_mask;        ///< from the motion filter, may be empty
+};
+
+/// Counters over all frames. frames = tracked + relocalized + lost + bad_frames.
+struct TrackerStats {
+  std::size_t frames = 0, tracked = 0, relocalized = 0, lost = 0, keyframes = 0;
+  std::size_t bad_frames = 0;
+};
+
+struct KeyframeInfo {
+  std::uint64_t id;
+  double timestamp_s;
+  Eigen::Isometry3d T_W_C;
+};
+
+/// RGB-D tracking front end: ORB features tracked by pyramidal LK, PnP-RANSAC + Ceres motion-only
+/// refinement against a local map of landmarks, keyframes, local bundle adjustment on its own
+/// thread and relocalization. The world frame is the camera frame of the first tracked frame.
+///
+/// Threading: track(), markBadFrame(), setMotionFilter(), finish() and the trajectory getters are
+/// called from one (the tracking) thread. takePoseUpdates() and stats() are thread-safe.
+class Tracker {
+ public:
+  /// `timings` may be null; it is borrowed and must outlive the tracker.
+  Tracker(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings);
+  ~Tracker();  ///< stops and joins the BA thread
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  void setMotionFilter(MotionFilter* filter);  ///< borrowed, may be null
+  /// frame.bgr CV_8UC3, frame.depth_m CV_32F metres (0 = none). Never throws on bad content:
+  /// an unusable frame comes back as kLost with the last known pose.
+  TrackingResult track(const RgbdFrame& frame);
+  /// A frame that could not be read: counted, gets kBadFrame, no pose.
+  void markBadFrame(double timestamp_s);
+  /// Keyframe poses corrected by BA since the last call. Thread-safe.
+  std::vector<PoseUpdate> takePoseUpdates();
+  /// Final BA over the window, stops the BA thread. Idempotent.
+  void finish();
+
+  /// One entry per frame given to track() (not bad frames): the pose relative to its reference
+  /// keyframe recomposed with that keyframe's latest optimised pose.
+  std::vector<std::pair<double, Eigen::Isometry3d>> finalTrajectory() const;
+  std::vector<FrameStatus> frameStatuses() const;  ///< parallel to finalTrajectory()
+  std::vector<KeyframeInfo> keyframes() const;     ///< latest optimised poses
+  TrackerStats stats() const;                      ///< thread-safe
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynamap

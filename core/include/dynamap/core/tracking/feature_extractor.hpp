@@ -1,0 +1,34 @@
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+
+#include "dynamap/core/tracker_config.hpp"
+
+namespace dynamap {
+
+/// ORB keypoints and their descriptors (one row per keypoint).
+struct OrbFeatures {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  ///< CV_8U, 32 bytes per row
+};
+
+/// ORB over a scale pyramid, spread evenly: the image is cut into square cells and only the
+/// strongest keypoint of each free cell is kept. Not thread-safe (cv::ORB keeps buffers).
+class GridOrbExtractor {
+ public:
+  explicit GridOrbExtractor(const TrackerConfig& config);
+
+  /// `allowed` CV_8UC1, non-zero = may detect there (empty = everywhere). Cells holding one of
+  /// `occupied` (already tracked features) get no new keypoint.
+  OrbFeatures extract(const cv::Mat& gray, const cv::Mat& allowed,
+                      const std::vector<cv::Point2f>& occupied) const;
+
+ private:
+  cv::Ptr<cv::ORB> orb_;
+  int cell_px_;
+};
+
+}  // namespace dynamap

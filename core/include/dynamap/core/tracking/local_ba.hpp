@@ -1,0 +1,54 @@
+#pragma once
+
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "dynamap/core/camera.hpp"
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/timing.hpp"
+#include "dynamap/core/tracker_config.hpp"
+#include "dynamap/core/tracking/local_map.hpp"
+
+namespace dynamap {
+
+/// Solves a BA window in place (poses of non-fixed keyframes and all points): reprojection +
+/// depth residuals, Huber loss, Ceres Schur solver. Returns false when nothing was solved.
+bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& config,
+                           BaWindow& window);
+
+/// Local bundle adjustment on its own thread. requestRun() (after each new keyframe) never
+/// blocks; the thread snapshots the window, solves without holding the map lock and writes the
+/// result back under it. Corrected keyframe poses queue up for takeUpdates(). Thread-safe.
+class LocalBundleAdjuster {
+ public:
+  LocalBundleAdjuster(const PinholeCamera& camera, const TrackerConfig& config, LocalMap& map,
+                      TimingRecorder* timings);
+  ~LocalBundleAdjuster();  ///< stops and joins
+  LocalBundleAdjuster(const LocalBundleAdjuster&) = delete;
+  LocalBundleAdjuster& operator=(const LocalBundleAdjuster&) = delete;
+
+  void start();
+  void requestRun();
+  void stop();     ///< finishes the running solve, joins; idempotent
+  void runOnce();  ///< one synchronous solve in the caller's thread
+  std::vector<PoseUpdate> takeUpdates();
+
+ private:
+  void loop();
+
+  PinholeCamera camera_;
+  TrackerConfig config_;
+  LocalMap& map_;
+  TimingRecorder* timings_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool pending_ = false;
+  bool stop_ = false;
+  std::thread thread_;
+  std::mutex updates_mutex_;
+  std::vector<PoseUpdate> updates_;
+};
+
+}  // namespace dynamap

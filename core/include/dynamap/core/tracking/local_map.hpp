@@ -1,0 +1,80 @@
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/tracker.hpp"
+
+namespace dynamap {
+
+/// A 3D point in the world with the ORB descriptor of its first observation.
+struct Landmark {
+  Eigen::Vector3d p_W;
+  cv::Mat descriptor;  ///< 1 x 32 CV_8U
+};
+
+struct KeyframeObservation {
+  std::uint64_t landmark_id = 0;
+  Eigen::Vector2d px;
+  double depth_m = 0.0;  ///< 0 = none
+};
+
+struct MapKeyframe {
+  std::uint64_t id = 0;
+  double timestamp_s = 0.0;
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  std::vector<KeyframeObservation> observations;
+};
+
+/// A copy of the sliding window handed to bundle adjustment (no lock held while solving).
+struct BaWindow {
+  struct Observation {
+    int keyframe;  ///< index into keyframe_ids / poses
+    int landmark;  ///< index into landmark_ids / points
+    Eigen::Vector2d px;
+    double depth_m;
+  };
+  std::vector<std::uint64_t> keyframe_ids;
+  std::vector<Eigen::Isometry3d> poses;
+  std::vector<std::uint8_t> fixed;
+  std::vector<std::uint64_t> landmark_ids;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Observation> observations;
+};
+
+/// Landmarks and keyframes shared by the tracking and BA threads. Every method is thread-safe;
+/// each holds the lock only for a copy in or out. Ids are dense indices (never removed).
+class LocalMap {
+ public:
+  std::uint64_t addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& descriptor);
+  std::uint64_t addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                            std::vector<KeyframeObservation> observations);
+  std::size_t keyframeCount() const;
+  Eigen::Isometry3d keyframePose(std::uint64_t id) const;
+  /// out[i] = position of ids[i].
+  void landmarkPositions(const std::vector<std::uint64_t>& ids,
+                         std::vector<Eigen::Vector3d>& out) const;
+
+  /// The newest `window` keyframes; the oldest `fixed` of them and up to `window` older ones
+  /// that see the same landmarks are held fixed.
+  BaWindow snapshotWindow(int window, int fixed) const;
+  /// Writes optimised poses and points back; returns the moved keyframes.
+  std::vector<PoseUpdate> apply(const BaWindow& solved);
+
+  /// Landmarks seen by the newest `keyframes` keyframes (ids, descriptors stacked, positions).
+  void relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
+                       std::vector<Eigen::Vector3d>& points) const;
+  std::vector<KeyframeInfo> keyframes() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<Landmark> landmarks_;
+  std::vector<MapKeyframe> keyframes_;
+};
+
+}  // namespace dynamap

@@ -1,0 +1,93 @@
+#pragma once
+
+// Internal state of dynamap::Tracker, shared by core/src/tracking/tracker*.cpp.
+
+#include <mutex>
+#include <vector>
+
+#include "dynamap/core/tracker.hpp"
+#include "dynamap/core/tracking/feature_extractor.hpp"
+#include "dynamap/core/tracking/lk_tracker.hpp"
+#include "dynamap/core/tracking/local_ba.hpp"
+#include "dynamap/core/tracking/local_map.hpp"
+#include "dynamap/core/tracking/pose_optimizer.hpp"
+#include "dynamap/core/tracking/relocalizer.hpp"
+
+namespace dynamap {
+
+/// A feature followed by LK from frame to frame; always backed by a landmark.
+struct FeatureTrack {
+  std::uint64_t landmark_id = 0;
+  cv::Point2f px;      ///< position in the latest frame
+  cv::Point2f px_ref;  ///< position in the reference keyframe (parallax test)
+};
+
+struct FrameRecord {
+  double timestamp_s = 0.0;
+  FrameStatus status = FrameStatus::kLost;
+  bool has_ref = false;
+  std::uint64_t ref_kf = 0;
+  Eigen::Isometry3d T_ref_C = Eigen::Isometry3d::Identity();  ///< used when has_ref
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();    ///< used otherwise
+};
+
+class Tracker::Impl {
+ public:
+  Impl(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings);
+
+  TrackingResult track(const RgbdFrame& frame);
+  void markBadFrame();
+  void finish();
+  std::vector<std::pair<double, Eigen::Isometry3d>> finalTrajectory() const;
+  std::vector<FrameStatus> frameStatuses() const;
+  TrackerStats stats() const;
+
+  MotionFilter* filter_ = nullptr;
+  LocalMap map_;
+  LocalBundleAdjuster ba_;
+
+ private:
+  Eigen::Isometry3d predictPose() const;
+  void matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d& T_W_C_pred,
+                     FeatureMatches& matches);
+  MotionFilterOutput runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
+                                     const FeatureMatches& matches);
+  int dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out);
+  bool estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
+  bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
+                  Eigen::Isometry3d& T_W_C, int& inliers);
+  bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const;
+  KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
+                                   const Eigen::Isometry3d& T_W_C, const cv::Mat& dynamic_mask);
+  OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
+  void record(double timestamp_s, FrameStatus status, const Eigen::Isometry3d& T_W_C);
+  void countStatus(FrameStatus status, bool keyframe);
+
+  PinholeCamera camera_;
+  TrackerConfig config_;
+  TimingRecorder* timings_;
+  GridOrbExtractor extractor_;
+  LkTracker lk_;
+  PoseOptimizer optimizer_;
+  Relocalizer relocalizer_;
+
+  LkPyramid prev_pyramid_;
+  cv::Mat prev_gray_;
+  std::vector<FeatureTrack> tracks_;  ///< parallel to the matches of the current frame
+  bool initialized_ = false;
+  bool finished_ = false;
+  Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
+  bool last_tracked_ = false;
+
+  std::uint64_t ref_kf_ = 0;
+  Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
+  double ref_timestamp_s_ = 0.0;
+  std::size_t ref_tracks_ = 0;
+
+  std::vector<FrameRecord> records_;
+  mutable std::mutex stats_mutex_;
+  TrackerStats stats_;
+};
+
+}  // namespace dynamap

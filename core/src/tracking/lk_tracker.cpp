@@ -1,0 +1,50 @@
+#include "dynamap/core/tracking/lk_tracker.hpp"
+
+#include <algorithm>
+
+#include <opencv2/video/tracking.hpp>
+
+namespace dynamap {
+
+LkTracker::LkTracker(const TrackerConfig& config)
+    : window_(config.lk_window_px, config.lk_window_px),
+      max_level_(std::max(0, config.lk_levels - 1)),
+      max_iterations_(config.lk_max_iterations),
+      fb_threshold_px_(config.lk_fb_threshold_px) {}
+
+LkPyramid LkTracker::buildPyramid(const cv::Mat& gray) const {
+  LkPyramid pyramid;
+  cv::buildOpticalFlowPyramid(gray, pyramid, window_, max_level_, true);
+  return pyramid;
+}
+
+void LkTracker::track(const LkPyramid& prev, const LkPyramid& cur,
+                      const std::vector<cv::Point2f>& prev_px, std::vector<cv::Point2f>& cur_px,
+                      std::vector<std::uint8_t>& ok) const {
+  ok.assign(prev_px.size(), 0);
+  if (prev_px.empty() || prev.empty() || cur.empty()) return;
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, max_iterations_,
+                                  0.01);
+  std::vector<std::uint8_t> fwd_status, bwd_status;
+  std::vector<float> err;
+  cv::calcOpticalFlowPyrLK(prev, cur, prev_px, cur_px, fwd_status, err, window_, max_level_,
+                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::vector<cv::Point2f> back_px = prev_px;
+  cv::calcOpticalFlowPyrLK(cur, prev, cur_px, back_px, bwd_status, err, window_, max_level_,
+                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  const cv::Size size = cur.front().size();
+  const double fb2 = fb_threshold_px_ * fb_threshold_px_;
+  for (std::size_t i = 0; i < prev_px.size(); ++i) {
+    if (!fwd_status[i] || !bwd_status[i]) continue;
+    const cv::Point2f d = back_px[i] - prev_px[i];
+    if (d.dot(d) > fb2) continue;
+    const cv::Point2f& p = cur_px[i];
+    if (p.x < 0.f || p.y < 0.f || p.x > static_cast<float>(size.width - 1) ||
+        p.y > static_cast<float>(size.height - 1)) {
+      continue;
+    }
+    ok[i] = 1;
+  }
+}
+
+}  // namespace dynamap

@@ -1,0 +1,106 @@
+#include "dynamap/core/tracking/local_ba.hpp"
+
+#include <array>
+
+#include "dynamap/core/tracking/rgbd_residual.hpp"
+
+namespace dynamap {
+
+bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& config,
+                           BaWindow& window) {
+  if (window.observations.empty() || window.landmark_ids.empty()) return false;
+  std::vector<std::array<double, 6>> poses(window.poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) toPoseBlock(window.poses[k], poses[k].data());
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::HuberLoss loss(config.robust_loss_sigma);
+  for (const auto& o : window.observations) {
+    const double inv_sigma_z = config.use_depth_residual && o.depth_m > 0.0
+                                   ? 1.0 / depthSigma(config.depth_sigma_coeff, o.depth_m)
+                                   : 0.0;
+    auto* cost = new ceres::AutoDiffCostFunction<RgbdResidual, 3, 6, 3>(
+        new RgbdResidual(camera, o.px, config.use_depth_residual ? o.depth_m : 0.0,
+                         1.0 / config.pixel_sigma_px, inv_sigma_z));
+    problem.AddResidualBlock(cost, &loss, poses[static_cast<std::size_t>(o.keyframe)].data(),
+                             window.points[static_cast<std::size_t>(o.landmark)].data());
+  }
+  bool any_free = false;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (window.fixed[k]) {
+      problem.SetParameterBlockConstant(poses[k].data());
+    } else {
+      any_free = true;
+    }
+  }
+  if (!any_free) return false;
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;
+  options.max_num_iterations = config.ba_max_iterations;
+  options.logging_type = ceres::SILENT;
+  options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return false;
+  for (std::size_t k = 0; k < poses.size(); ++k) window.poses[k] = fromPoseBlock(poses[k].data());
+  return true;
+}
+
+LocalBundleAdjuster::LocalBundleAdjuster(const PinholeCamera& camera, const TrackerConfig& config,
+                                         LocalMap& map, TimingRecorder* timings)
+    : camera_(camera), config_(config), map_(map), timings_(timings) {}
+
+LocalBundleAdjuster::~LocalBundleAdjuster() { stop(); }
+
+void LocalBundleAdjuster::start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (thread_.joinable() || stop_) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void LocalBundleAdjuster::requestRun() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = true;
+  }
+  wake_.notify_one();
+}
+
+void LocalBundleAdjuster::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LocalBundleAdjuster::runOnce() {
+  ScopedStageTimer timer(timings_, "ba");
+  BaWindow window = map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
+  if (!solveBundleAdjustment(camera_, config_, window)) return;
+  std::vector<PoseUpdate> moved = map_.apply(window);
+  std::lock_guard<std::mutex> lock(updates_mutex_);
+  updates_.insert(updates_.end(), moved.begin(), moved.end());
+}
+
+std::vector<PoseUpdate> LocalBundleAdjuster::takeUpdates() {
+  std::lock_guard<std::mutex> lock(updates_mutex_);
+  std::vector<PoseUpdate> out;
+  out.swap(updates_);
+  return out;
+}
+
+void LocalBundleAdjuster::loop() {
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return pending_ || stop_; });
+      if (stop_) return;
+      pending_ = false;
+    }
+    runOnce();
+  }
+}
+
+}  // namespace dynamap

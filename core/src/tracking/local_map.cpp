@@ -1,0 +1,121 @@
+#include "dynamap/core/tracking/local_map.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace dynamap {
+
+std::uint64_t LocalMap::addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& descriptor) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  landmarks_.push_back(Landmark{p_W, descriptor.clone()});
+  return landmarks_.size() - 1;
+}
+
+std::uint64_t LocalMap::addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                                    std::vector<KeyframeObservation> observations) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  MapKeyframe kf;
+  kf.id = keyframes_.size();
+  kf.timestamp_s = timestamp_s;
+  kf.T_W_C = T_W_C;
+  kf.observations = std::move(observations);
+  keyframes_.push_back(std::move(kf));
+  return keyframes_.back().id;
+}
+
+std::size_t LocalMap::keyframeCount() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return keyframes_.size();
+}
+
+Eigen::Isometry3d LocalMap::keyframePose(std::uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return keyframes_.at(id).T_W_C;
+}
+
+void LocalMap::landmarkPositions(const std::vector<std::uint64_t>& ids,
+                                 std::vector<Eigen::Vector3d>& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  out.resize(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].p_W;
+}
+
+BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  BaWindow w;
+  const int n = static_cast<int>(keyframes_.size());
+  const int first_opt = std::max(0, n - window);
+  const int first = std::max(0, first_opt - window);
+  const int first_free = std::max(first_opt + fixed, 1);  // keyframe 0 defines the world
+  if (first_free >= n) return w;
+  std::unordered_map<std::uint64_t, int> lm_index;
+  for (int k = first_free; k < n; ++k) {
+    for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
+      if (lm_index.emplace(o.landmark_id, static_cast<int>(w.landmark_ids.size())).second) {
+        w.landmark_ids.push_back(o.landmark_id);
+        w.points.push_back(landmarks_[o.landmark_id].p_W);
+      }
+    }
+  }
+  for (int k = first; k < n; ++k) {
+    const auto& kf = keyframes_[static_cast<std::size_t>(k)];
+    const int kf_index = static_cast<int>(w.keyframe_ids.size());
+    bool any = false;
+    for (const auto& o : kf.observations) {
+      auto it = lm_index.find(o.landmark_id);
+      if (it == lm_index.end()) continue;
+      w.observations.push_back({kf_index, it->second, o.px, o.depth_m});
+      any = true;
+    }
+    if (!any) continue;
+    w.keyframe_ids.push_back(kf.id);
+    w.poses.push_back(kf.T_W_C);
+    w.fixed.push_back(k < first_free ? 1 : 0);
+  }
+  return w;
+}
+
+std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<PoseUpdate> updates;
+  for (std::size_t k = 0; k < solved.keyframe_ids.size(); ++k) {
+    if (solved.fixed[k]) continue;
+    keyframes_[solved.keyframe_ids[k]].T_W_C = solved.poses[k];
+    updates.push_back(PoseUpdate{solved.keyframe_ids[k], solved.poses[k]});
+  }
+  for (std::size_t i = 0; i < solved.landmark_ids.size(); ++i) {
+    landmarks_[solved.landmark_ids[i]].p_W = solved.points[i];
+  }
+  return updates;
+}
+
+void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
+                               std::vector<Eigen::Vector3d>& points) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ids.clear();
+  points.clear();
+  descriptors.release();
+  std::unordered_set<std::uint64_t> seen;
+  const int n = static_cast<int>(keyframes_.size());
+  for (int k = n - 1; k >= std::max(0, n - keyframes); --k) {
+    for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
+      if (!seen.insert(o.landmark_id).second) continue;
+      const Landmark& lm = landmarks_[o.landmark_id];
+      if (lm.descriptor.empty()) continue;
+      ids.push_back(o.landmark_id);
+      points.push_back(lm.p_W);
+      descriptors.push_back(lm.descriptor);
+    }
+  }
+}
+
+std::vector<KeyframeInfo> LocalMap::keyframes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<KeyframeInfo> out;
+  out.reserve(keyframes_.size());
+  for (const auto& kf : keyframes_) out.push_back(KeyframeInfo{kf.id, kf.timestamp_s, kf.T_W_C});
+  return out;
+}
+
+}  // namespace dynamap

@@ -1,0 +1,128 @@
+#include "dynamap/core/tracking/pose_optimizer.hpp"
+
+#include <memory>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "dynamap/core/tracking/rgbd_residual.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr double kChi2Mono = 5.991;    // 95 %, 2 dof
+constexpr double kChi2Stereo = 7.815;  // 95 %, 3 dof
+
+RgbdResidual makeResidual(const PinholeCamera& camera, const TrackerConfig& config,
+                          const PoseCorrespondence& c) {
+  const double inv_sigma_z = config.use_depth_residual && c.depth_m > 0.0
+                                 ? 1.0 / depthSigma(config.depth_sigma_coeff, c.depth_m)
+                                 : 0.0;
+  return RgbdResidual(camera, c.px, config.use_depth_residual ? c.depth_m : 0.0,
+                      1.0 / config.pixel_sigma_px, inv_sigma_z);
+}
+
+}  // namespace
+
+PoseOptimizer::PoseOptimizer(const PinholeCamera& camera, const TrackerConfig& config)
+    : camera_(camera), config_(config) {}
+
+bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
+                           std::vector<std::uint8_t>& inlier, bool use_guess) const {
+  inlier.assign(corr.size(), 0);
+  if (corr.size() < 6) return false;
+  std::vector<cv::Point3f> object;
+  std::vector<cv::Point2f> image;
+  object.reserve(corr.size());
+  image.reserve(corr.size());
+  for (const auto& c : corr) {
+    object.emplace_back(static_cast<float>(c.p_W.x()), static_cast<float>(c.p_W.y()),
+                        static_cast<float>(c.p_W.z()));
+    image.emplace_back(static_cast<float>(c.px.x()), static_cast<float>(c.px.y()));
+  }
+  const cv::Matx33d K(camera_.fx, 0, camera_.cx, 0, camera_.fy, camera_.cy, 0, 0, 1);
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  cv::Mat R, rvec, tvec;
+  cv::eigen2cv(Eigen::Matrix3d(T_C_W.rotation()), R);
+  cv::Rodrigues(R, rvec);
+  cv::eigen2cv(Eigen::Vector3d(T_C_W.translation()), tvec);
+  std::vector<int> idx;
+  const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, use_guess,
+                                     config_.pnp_ransac_iterations,
+                                     static_cast<float>(config_.pnp_reprojection_px), 0.99, idx,
+                                     use_guess ? cv::SOLVEPNP_ITERATIVE : cv::SOLVEPNP_AP3P);
+  if (!ok || static_cast<int>(idx.size()) < 4) return false;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d Re;
+  Eigen::Vector3d te;
+  cv::cv2eigen(R, Re);
+  cv::cv2eigen(tvec, te);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Re;
+  T.translation() = te;
+  T_W_C = T.inverse();
+  for (int i : idx) inlier[static_cast<std::size_t>(i)] = 1;
+  return true;
+}
+
+int PoseOptimizer::refine(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
+                          std::vector<std::uint8_t>& inlier) const {
+  double pose[6];
+  toPoseBlock(T_W_C, pose);
+  ceres::HuberLoss loss(config_.robust_loss_sigma);
+  int count = 0;
+  for (int round = 0; round < 2; ++round) {
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    int used = 0;
+    for (std::size_t i = 0; i < corr.size(); ++i) {
+      if (!inlier[i]) continue;
+      auto* cost = new ceres::AutoDiffCostFunction<RgbdPoseOnlyResidual, 3, 6>(
+          new RgbdPoseOnlyResidual(makeResidual(camera_, config_, corr[i]), corr[i].p_W));
+      problem.AddResidualBlock(cost, &loss, pose);
+      ++used;
+    }
+    if (used < 4) break;
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = config_.refine_iterations;
+    options.logging_type = ceres::SILENT;
+    options.num_threads = 1;
+    ceres::Solver::Summary summary;
+    if (config_.refine_iterations > 0) ceres::Solve(options, &problem, &summary);
+    count = 0;
+    for (std::size_t i = 0; i < corr.size(); ++i) {
+      const RgbdResidual r = makeResidual(camera_, config_, corr[i]);
+      double res[3];
+      r(pose, corr[i].p_W.data(), res);
+      const double chi2 = res[0] * res[0] + res[1] * res[1] + res[2] * res[2];
+      const bool ok = chi2 < (r.w_z > 0.0 ? kChi2Stereo : kChi2Mono);
+      inlier[i] = ok ? 1 : 0;
+      count += ok ? 1 : 0;
+    }
+  }
+  T_W_C = fromPoseBlock(pose);
+  return count;
+}
+
+PoseEstimate PoseOptimizer::estimate(const std::vector<PoseCorrespondence>& corr,
+                                     const Eigen::Isometry3d& T_W_C_guess,
+                                     TimingRecorder* timings) const {
+  PoseEstimate est;
+  est.T_W_C = T_W_C_guess;
+  {
+    ScopedStageTimer timer(timings, "pnp");
+    if (!ransac(corr, est.T_W_C, est.inlier)) {
+      // No RANSAC model: start the robust refinement from the prediction with every match.
+      est.T_W_C = T_W_C_guess;
+      est.inlier.assign(corr.size(), 1);
+    }
+  }
+  ScopedStageTimer timer(timings, "pose_refine");
+  est.inliers = refine(corr, est.T_W_C, est.inlier);
+  est.ok = est.inliers >= config_.min_inliers;
+  return est;
+}
+
+}  // namespace dynamap

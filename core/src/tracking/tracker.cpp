@@ -1,0 +1,194 @@
+#include "dynamap/core/tracker.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include "dynamap/core/tracking/tracker_impl.hpp"
+
+namespace dynamap {
+namespace {
+
+cv::Mat toGray(const cv::Mat& image, const PinholeCamera& camera) {
+  if (image.empty()) return cv::Mat::zeros(camera.height, camera.width, CV_8UC1);
+  if (image.type() == CV_8UC1) return image;
+  cv::Mat gray;
+  cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+}  // namespace
+
+Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
+                    TimingRecorder* timings)
+    : ba_(camera, config, map_, timings),
+      camera_(camera),
+      config_(config),
+      timings_(timings),
+      extractor_(config),
+      lk_(config),
+      optimizer_(camera, config),
+      relocalizer_(config, optimizer_) {
+  if (config_.bundle_adjustment) ba_.start();
+}
+
+// The per-frame step: match -> dynamic filter -> pose -> (relocalize) -> keyframe.
+TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
+  ScopedStageTimer total(timings_, "tracking");
+  if (filter_) filter_->beginFrame(frame);
+  const cv::Mat gray = toGray(frame.bgr, camera_);
+  const Eigen::Isometry3d T_W_C_pred = predictPose();
+  LkPyramid pyramid;
+  FeatureMatches matches;
+  {
+    ScopedStageTimer timer(timings_, "lk");
+    pyramid = lk_.buildPyramid(gray);
+    matchFeatures(pyramid, T_W_C_pred, matches);
+  }
+  TrackingResult result;
+  const MotionFilterOutput filtered = runMotionFilter(frame, gray, matches);
+  result.dynamic_mask = filtered.dynamic_mask;
+  result.dynamic_matches = dropDynamic(matches, filtered);
+  result.tracked_features = static_cast<int>(tracks_.size());
+
+  Eigen::Isometry3d T_W_C = T_W_C_pred;
+  if (!initialized_) {
+    result.status = FrameStatus::kLost;
+    result.T_W_C = T_W_last_;
+    tracks_.clear();
+    result.keyframe =
+        createKeyframe(frame, gray, Eigen::Isometry3d::Identity(), filtered.dynamic_mask);
+    if (result.keyframe) {
+      initialized_ = true;
+      result.status = FrameStatus::kTracked;
+      result.T_W_C = Eigen::Isometry3d::Identity();
+      result.inliers = static_cast<int>(tracks_.size());
+    }
+  } else if (estimatePose(frame, T_W_C, result.inliers)) {
+    result.status = FrameStatus::kTracked;
+  } else if (relocalize(frame, gray, filtered.dynamic_mask, T_W_C, result.inliers)) {
+    result.status = FrameStatus::kRelocalized;
+  } else {
+    result.status = FrameStatus::kLost;
+  }
+
+  if (initialized_ && result.status != FrameStatus::kLost && !result.keyframe) {
+    result.T_W_C = T_W_C;
+    if (needKeyframe(frame.timestamp_s, T_W_C)) {
+      result.keyframe = createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask);
+    }
+  }
+  if (result.status == FrameStatus::kLost) {
+    result.T_W_C = T_W_last_;
+    tracks_.clear();
+    last_tracked_ = false;
+  } else {
+    velocity_ = last_tracked_ ? T_W_last_.inverse() * result.T_W_C : Eigen::Isometry3d::Identity();
+    T_W_last_ = result.T_W_C;
+    last_tracked_ = true;
+  }
+  result.is_keyframe = static_cast<bool>(result.keyframe);
+  record(frame.timestamp_s, result.status, result.T_W_C);
+  countStatus(result.status, result.is_keyframe);
+  prev_pyramid_ = std::move(pyramid);
+  prev_gray_ = gray;
+  return result;
+}
+
+Eigen::Isometry3d Tracker::Impl::predictPose() const {
+  return last_tracked_ ? T_W_last_ * velocity_ : T_W_last_;
+}
+
+void Tracker::Impl::matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d& T_W_C_pred,
+                                  FeatureMatches& matches) {
+  if (tracks_.empty() || prev_pyramid_.empty()) {
+    tracks_.clear();
+    return;
+  }
+  std::vector<std::uint64_t> ids(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) ids[i] = tracks_[i].landmark_id;
+  std::vector<Eigen::Vector3d> p_W;
+  map_.landmarkPositions(ids, p_W);
+  // Constant-velocity prior: the landmark projected with the predicted pose seeds LK.
+  const Eigen::Isometry3d T_C_W = T_W_C_pred.inverse();
+  std::vector<cv::Point2f> prev_px(tracks_.size()), cur_px(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    prev_px[i] = tracks_[i].px;
+    cur_px[i] = tracks_[i].px;
+    const Eigen::Vector3d p_C = T_C_W * p_W[i];
+    if (p_C.z() <= 0.05) continue;
+    const Eigen::Vector2d uv = camera_.project(p_C);
+    if (uv.x() >= 0 && uv.y() >= 0 && uv.x() < camera_.width && uv.y() < camera_.height) {
+      cur_px[i] = cv::Point2f(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
+    }
+  }
+  std::vector<std::uint8_t> ok;
+  lk_.track(prev_pyramid_, cur, prev_px, cur_px, ok);
+  std::vector<FeatureTrack> kept;
+  kept.reserve(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    if (!ok[i]) continue;
+    FeatureTrack t = tracks_[i];
+    t.px = cur_px[i];
+    kept.push_back(t);
+    matches.prev_px.push_back(prev_px[i]);
+    matches.cur_px.push_back(cur_px[i]);
+  }
+  tracks_.swap(kept);
+}
+
+MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
+                                                  const FeatureMatches& matches) {
+  if (!filter_) return {};
+  ScopedStageTimer timer(timings_, "motion_filter");
+  MotionFilterInput input;
+  input.frame = &frame;
+  input.prev_gray = prev_gray_.empty() ? &gray : &prev_gray_;
+  input.cur_gray = &gray;
+  input.matches = &matches;
+  return filter_->filter(input);
+}
+
+int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out) {
+  const bool has_flags = out.match_is_dynamic.size() == matches.cur_px.size();
+  const bool has_mask = !out.dynamic_mask.empty() && out.dynamic_mask.type() == CV_8UC1;
+  if (!has_flags && !has_mask) return 0;
+  int dropped = 0;
+  std::vector<FeatureTrack> kept;
+  kept.reserve(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    bool dynamic = has_flags && out.match_is_dynamic[i] != 0;
+    if (!dynamic && has_mask) {
+      const int x = static_cast<int>(tracks_[i].px.x + 0.5f);
+      const int y = static_cast<int>(tracks_[i].px.y + 0.5f);
+      dynamic = x >= 0 && y >= 0 && x < out.dynamic_mask.cols && y < out.dynamic_mask.rows &&
+                out.dynamic_mask.at<std::uint8_t>(y, x) == 255;
+    }
+    if (dynamic) {
+      ++dropped;
+    } else {
+      kept.push_back(tracks_[i]);
+    }
+  }
+  tracks_.swap(kept);
+  return dropped;
+}
+
+// ---- public wrappers ----
+
+Tracker::Tracker(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings)
+    : impl_(std::make_unique<Impl>(camera, config, timings)) {}
+
+Tracker::~Tracker() { impl_->ba_.stop(); }
+
+void Tracker::setMotionFilter(MotionFilter* filter) { impl_->filter_ = filter; }
+TrackingResult Tracker::track(const RgbdFrame& frame) { return impl_->track(frame); }
+void Tracker::markBadFrame(double /*timestamp_s*/) { impl_->markBadFrame(); }
+std::vector<PoseUpdate> Tracker::takePoseUpdates() { return impl_->ba_.takeUpdates(); }
+void Tracker::finish() { impl_->finish(); }
+std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::finalTrajectory() const {
+  return impl_->finalTrajectory();
+}
+std::vector<FrameStatus> Tracker::frameStatuses() const { return impl_->frameStatuses(); }
+std::vector<KeyframeInfo> Tracker::keyframes() const { return impl_->map_.keyframes(); }
+TrackerStats Tracker::stats() const { return impl_->stats(); }
+
+}  // namespace dynamap

@@ -1,0 +1,197 @@
+// Pose estimation, relocalization, keyframes and bookkeeping of Tracker::Impl.
+#include <algorithm>
+#include <cmath>
+
+#include "dynamap/core/tracking/depth_sampling.hpp"
+#include "dynamap/core/tracking/tracker_impl.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr int kMinInitialLandmarks = 30;
+
+double rotationDeg(const Eigen::Isometry3d& T) {
+  return Eigen::AngleAxisd(T.rotation()).angle() * 180.0 / M_PI;
+}
+
+}  // namespace
+
+bool Tracker::Impl::estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers) {
+  inliers = 0;
+  if (static_cast<int>(tracks_.size()) < config_.min_inliers) return false;
+  std::vector<std::uint64_t> ids(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) ids[i] = tracks_[i].landmark_id;
+  std::vector<Eigen::Vector3d> p_W;
+  map_.landmarkPositions(ids, p_W);
+  std::vector<PoseCorrespondence> corr(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    corr[i].p_W = p_W[i];
+    corr[i].px = Eigen::Vector2d(tracks_[i].px.x, tracks_[i].px.y);
+    corr[i].depth_m = sampleDepth(frame.depth_m, tracks_[i].px.x, tracks_[i].px.y,
+                                  config_.depth_min_m, config_.depth_max_m);
+  }
+  const PoseEstimate est = optimizer_.estimate(corr, T_W_C, timings_);
+  if (!est.ok) return false;
+  std::vector<FeatureTrack> kept;
+  kept.reserve(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    if (est.inlier[i]) kept.push_back(tracks_[i]);
+  }
+  tracks_.swap(kept);
+  T_W_C = est.T_W_C;
+  inliers = est.inliers;
+  return true;
+}
+
+OrbFeatures Tracker::Impl::extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask) {
+  ScopedStageTimer timer(timings_, "orb");
+  cv::Mat allowed;
+  if (!dynamic_mask.empty()) allowed = dynamic_mask != 255;
+  std::vector<cv::Point2f> occupied;
+  occupied.reserve(tracks_.size());
+  for (const auto& t : tracks_) occupied.push_back(t.px);
+  return extractor_.extract(gray, allowed, occupied);
+}
+
+bool Tracker::Impl::relocalize(const RgbdFrame& frame, const cv::Mat& gray,
+                               const cv::Mat& dynamic_mask, Eigen::Isometry3d& T_W_C,
+                               int& inliers) {
+  tracks_.clear();
+  const OrbFeatures features = extractOrb(gray, dynamic_mask);
+  const RelocalizationResult reloc = relocalizer_.relocalize(features, frame.depth_m, map_);
+  if (!reloc.ok) return false;
+  for (std::size_t i = 0; i < reloc.landmark_ids.size(); ++i) {
+    tracks_.push_back(FeatureTrack{reloc.landmark_ids[i], reloc.px[i], reloc.px[i]});
+  }
+  T_W_C = reloc.T_W_C;
+  inliers = reloc.inliers;
+  return true;
+}
+
+bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const {
+  if (static_cast<int>(tracks_.size()) < config_.min_tracked_features) return true;
+  if (static_cast<double>(tracks_.size()) <
+      config_.kf_min_tracked_ratio * static_cast<double>(ref_tracks_)) {
+    return true;
+  }
+  const Eigen::Isometry3d T_ref_C = ref_T_W_C_.inverse() * T_W_C;
+  if (T_ref_C.translation().norm() > config_.kf_max_translation_m) return true;
+  if (rotationDeg(T_ref_C) > config_.kf_max_rotation_deg) return true;
+  if (timestamp_s - ref_timestamp_s_ > config_.kf_max_interval_s) return true;
+  std::vector<float> parallax;
+  parallax.reserve(tracks_.size());
+  for (const auto& t : tracks_) parallax.push_back(static_cast<float>(cv::norm(t.px - t.px_ref)));
+  if (parallax.empty()) return true;
+  auto mid = parallax.begin() + static_cast<std::ptrdiff_t>(parallax.size() / 2);
+  std::nth_element(parallax.begin(), mid, parallax.end());
+  return *mid > config_.kf_max_parallax_px;
+}
+
+KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
+                                                const Eigen::Isometry3d& T_W_C,
+                                                const cv::Mat& dynamic_mask) {
+  const OrbFeatures features = extractOrb(gray, dynamic_mask);
+  const double max_landmark_m = std::min(config_.depth_max_m, config_.landmark_depth_max_m);
+  std::vector<int> fresh;
+  std::vector<double> fresh_depth;
+  for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
+    const cv::Point2f& p = features.keypoints[i].pt;
+    const double z = sampleDepth(frame.depth_m, p.x, p.y, config_.depth_min_m, max_landmark_m);
+    if (z <= 0.0) continue;
+    fresh.push_back(static_cast<int>(i));
+    fresh_depth.push_back(z);
+  }
+  if (!initialized_ && static_cast<int>(fresh.size()) < kMinInitialLandmarks) return nullptr;
+
+  std::vector<KeyframeObservation> observations;
+  observations.reserve(tracks_.size() + fresh.size());
+  for (const auto& t : tracks_) {
+    const double z =
+        sampleDepth(frame.depth_m, t.px.x, t.px.y, config_.depth_min_m, config_.depth_max_m);
+    observations.push_back({t.landmark_id, Eigen::Vector2d(t.px.x, t.px.y), z});
+  }
+  for (std::size_t j = 0; j < fresh.size(); ++j) {
+    const auto i = static_cast<std::size_t>(fresh[j]);
+    const cv::Point2f& p = features.keypoints[i].pt;
+    const Eigen::Vector3d p_W = T_W_C * camera_.backProject(p.x, p.y, fresh_depth[j]);
+    const std::uint64_t id = map_.addLandmark(p_W, features.descriptors.row(fresh[j]));
+    tracks_.push_back(FeatureTrack{id, p, p});
+    observations.push_back({id, Eigen::Vector2d(p.x, p.y), fresh_depth[j]});
+  }
+  const std::uint64_t kf_id = map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations));
+  ref_kf_ = kf_id;
+  ref_T_W_C_ = T_W_C;
+  ref_timestamp_s_ = frame.timestamp_s;
+  ref_tracks_ = tracks_.size();
+  for (auto& t : tracks_) t.px_ref = t.px;
+  if (config_.bundle_adjustment && !finished_) ba_.requestRun();
+
+  auto packet = std::make_shared<KeyframePacket>();
+  packet->id = kf_id;
+  packet->timestamp_s = frame.timestamp_s;
+  packet->T_W_C = T_W_C;
+  packet->bgr = frame.bgr.clone();
+  packet->depth_m = frame.depth_m.clone();
+  packet->dynamic_mask = dynamic_mask.clone();
+  return packet;
+}
+
+void Tracker::Impl::record(double timestamp_s, FrameStatus status, const Eigen::Isometry3d& T_W_C) {
+  FrameRecord r;
+  r.timestamp_s = timestamp_s;
+  r.status = status;
+  r.T_W_C = T_W_C;
+  if (initialized_) {
+    r.has_ref = true;
+    r.ref_kf = ref_kf_;
+    r.T_ref_C = map_.keyframePose(ref_kf_).inverse() * T_W_C;
+  }
+  records_.push_back(r);
+}
+
+void Tracker::Impl::countStatus(FrameStatus status, bool keyframe) {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++stats_.frames;
+  if (status == FrameStatus::kTracked) ++stats_.tracked;
+  if (status == FrameStatus::kRelocalized) ++stats_.relocalized;
+  if (status == FrameStatus::kLost) ++stats_.lost;
+  if (keyframe) ++stats_.keyframes;
+}
+
+void Tracker::Impl::markBadFrame() {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++stats_.frames;
+  ++stats_.bad_frames;
+}
+
+void Tracker::Impl::finish() {
+  if (finished_) return;
+  finished_ = true;
+  ba_.stop();
+  if (config_.bundle_adjustment) ba_.runOnce();
+}
+
+std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory() const {
+  const std::vector<KeyframeInfo> kfs = map_.keyframes();
+  std::vector<std::pair<double, Eigen::Isometry3d>> out;
+  out.reserve(records_.size());
+  for (const auto& r : records_) {
+    const Eigen::Isometry3d T_W_C = r.has_ref ? kfs.at(r.ref_kf).T_W_C * r.T_ref_C : r.T_W_C;
+    out.emplace_back(r.timestamp_s, T_W_C);
+  }
+  return out;
+}
+
+std::vector<FrameStatus> Tracker::Impl::frameStatuses() const {
+  std::vector<FrameStatus> out;
+  out.reserve(records_.size());
+  for (const auto& r : records_) out.push_back(r.status);
+  return out;
+}
+
+TrackerStats Tracker::Impl::stats() const {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  return stats_;
+}
+
+}  // namespace dynamap

@@ -1,0 +1,59 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "dynamap/core/tracking/lk_tracker.hpp"
+#include "synthetic_scene.hpp"
+
+namespace dynamap {
+namespace {
+
+TEST(LkTracker, TracksKnownSubPixelShift) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 5);
+  scene.addPlane({-2.0, -1.5, 1.5}, {4.0, 0, 0}, {0, 3.0, 0});
+  const auto frame = scene.render(Eigen::Isometry3d::Identity(), 0.0);
+  cv::Mat gray, shifted;
+  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+  const cv::Point2f shift(7.35f, -4.6f);
+  const cv::Matx23d M(1, 0, shift.x, 0, 1, shift.y);
+  cv::warpAffine(gray, shifted, M, gray.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+
+  std::vector<cv::Point2f> prev_px;
+  cv::goodFeaturesToTrack(gray, prev_px, 300, 0.01, 15);
+  std::vector<cv::Point2f> kept;
+  for (const auto& p : prev_px) {
+    if (p.x > 40 && p.y > 40 && p.x < gray.cols - 40 && p.y < gray.rows - 40) kept.push_back(p);
+  }
+  ASSERT_GT(kept.size(), 100u);
+
+  TrackerConfig config;
+  const LkTracker lk(config);
+  const LkPyramid a = lk.buildPyramid(gray), b = lk.buildPyramid(shifted);
+  std::vector<cv::Point2f> cur_px = kept;  // no prior: LK must find the whole shift
+  std::vector<std::uint8_t> ok;
+  lk.track(a, b, kept, cur_px, ok);
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (!ok[i]) continue;
+    sum += cv::norm(cur_px[i] - (kept[i] + shift));
+    ++n;
+  }
+  EXPECT_GT(n, static_cast<int>(0.9 * kept.size()));
+  EXPECT_LT(sum / n, 0.1);
+}
+
+TEST(LkTracker, ForwardBackwardCheckRejectsUntrackablePoints) {
+  TrackerConfig config;
+  const LkTracker lk(config);
+  cv::Mat flat(480, 640, CV_8UC1, cv::Scalar(128));
+  const LkPyramid a = lk.buildPyramid(flat), b = lk.buildPyramid(flat);
+  std::vector<cv::Point2f> prev_px{{100, 100}, {320, 240}}, cur_px = prev_px;
+  std::vector<std::uint8_t> ok;
+  lk.track(a, b, prev_px, cur_px, ok);
+  EXPECT_EQ(ok[0] + ok[1], 0);
+}
+
+}  // namespace
+}  // namespace dynamap

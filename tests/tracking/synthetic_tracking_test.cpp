@@ -1,0 +1,164 @@
+#include <gtest/gtest.h>
+
+#include <iostream>
+
+#include "dynamap/core/tracker.hpp"
+#include "synthetic_scene.hpp"
+#include "tracking_test_utils.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr int kFrames = 60;
+constexpr double kFramePeriodS = 1.0 / 30.0;
+
+RgbdFrame makeFrame(const test::RenderedFrame& r, int i) {
+  RgbdFrame f;
+  f.index = static_cast<std::size_t>(i);
+  f.timestamp_s = i * kFramePeriodS;
+  f.bgr = r.bgr;
+  f.depth_m = r.depth_m;
+  return f;
+}
+
+/// Translation error of frame i against the truth re-expressed in frame 0's camera frame.
+double translationError(const Eigen::Isometry3d& est, int i) {
+  const Eigen::Isometry3d truth =
+      test::smoothPath(0, kFrames).inverse() * test::smoothPath(i, kFrames);
+  return (est.translation() - truth.translation()).norm();
+}
+
+TEST(SyntheticTracking, SmoothSixDofSequenceHasSubCentimetreAte) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 11);
+  scene.addDefaultRoom();
+  TimingRecorder timings;
+  Tracker tracker(camera, TrackerConfig{}, &timings);
+  int keyframes = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    EXPECT_EQ(res.status, FrameStatus::kTracked) << "frame " << i;
+    EXPECT_EQ(res.is_keyframe, static_cast<bool>(res.keyframe));
+    keyframes += res.is_keyframe ? 1 : 0;
+    if (i == 0) {
+      EXPECT_TRUE(res.is_keyframe);
+      EXPECT_TRUE(res.T_W_C.isApprox(Eigen::Isometry3d::Identity()));
+    }
+  }
+  tracker.finish();
+  const auto traj = tracker.finalTrajectory();
+  ASSERT_EQ(traj.size(), static_cast<std::size_t>(kFrames));
+  double sum2 = 0.0;
+  for (int i = 0; i < kFrames; ++i) {
+    const double e = translationError(traj[static_cast<std::size_t>(i)].second, i);
+    sum2 += e * e;
+  }
+  const double ate = std::sqrt(sum2 / kFrames);
+  std::cout << "[synthetic] ATE RMSE " << ate * 100 << " cm, keyframes " << keyframes
+            << ", median tracking " << timings.stats("tracking").median_ms << " ms\n";
+  EXPECT_LT(ate, 0.01);  // world frame = frame 0, no alignment needed
+  EXPECT_GT(keyframes, 1);
+  EXPECT_EQ(tracker.stats().tracked, static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(tracker.keyframes().size(), static_cast<std::size_t>(keyframes));
+  EXPECT_GT(timings.stats("lk").count, 0u);
+  EXPECT_GT(timings.stats("orb").count, 0u);
+  EXPECT_LT(timings.stats("orb").count, static_cast<std::size_t>(kFrames));  // not every frame
+}
+
+TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 12);
+  scene.addDefaultRoom();
+  Tracker tracker(camera, TrackerConfig{}, nullptr);
+  constexpr int kBlankFirst = 25, kBlankLast = 28;
+  for (int i = 0; i < 45; ++i) {
+    auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    if (i >= kBlankFirst && i <= kBlankLast) {
+      r.bgr.setTo(cv::Scalar::all(0));
+      r.depth_m.setTo(0.f);
+    }
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    if (i >= kBlankFirst && i <= kBlankLast) {
+      EXPECT_EQ(res.status, FrameStatus::kLost) << "frame " << i;
+    }
+    if (i == 30) tracker.markBadFrame(i * kFramePeriodS + 0.01);
+  }
+  tracker.finish();
+  const auto statuses = tracker.frameStatuses();
+  const auto traj = tracker.finalTrajectory();
+  ASSERT_EQ(statuses.size(), 45u);
+  EXPECT_EQ(statuses[kBlankLast + 1], FrameStatus::kRelocalized);
+  for (int i = kBlankLast + 2; i < 45; ++i) {
+    EXPECT_EQ(statuses[static_cast<std::size_t>(i)], FrameStatus::kTracked) << "frame " << i;
+  }
+  for (int i = kBlankLast + 1; i < 45; ++i) {
+    EXPECT_LT(translationError(traj[static_cast<std::size_t>(i)].second, i), 0.02) << i;
+  }
+  const TrackerStats s = tracker.stats();
+  EXPECT_EQ(s.frames, 46u);
+  EXPECT_EQ(s.bad_frames, 1u);
+  EXPECT_EQ(s.lost, static_cast<std::size_t>(kBlankLast - kBlankFirst + 1));
+  EXPECT_EQ(s.relocalized, 1u);
+  EXPECT_EQ(s.tracked + s.relocalized + s.lost + s.bad_frames, s.frames);
+}
+
+/// Flags every match and masks every pixel of the moving box (from the renderer's mask).
+class OracleMotionFilter : public MotionFilter {
+ public:
+  void beginFrame(const RgbdFrame& frame) override {
+    ++begun;
+    mask = masks.at(frame.index);
+  }
+  MotionFilterOutput filter(const MotionFilterInput& input) override {
+    ++filtered;
+    MotionFilterOutput out;
+    out.dynamic_mask = mask;
+    for (const auto& p : input.matches->cur_px) {
+      out.match_is_dynamic.push_back(mask.at<std::uint8_t>(cvRound(p.y), cvRound(p.x)) == 255);
+    }
+    return out;
+  }
+  std::vector<cv::Mat> masks;
+  cv::Mat mask;
+  int begun = 0, filtered = 0;
+};
+
+TEST(SyntheticTracking, MovingBoxIsMaskedOutAndPoseStaysAccurate) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 13);
+  scene.addDefaultRoom();
+  scene.addMovingBox({-0.2, 0.0, 1.6}, {0.3, 0.3, 0.3}, {0.6, 0.0, 0.0});
+  OracleMotionFilter oracle;
+  std::vector<test::RenderedFrame> frames;
+  for (int i = 0; i < 40; ++i) {
+    frames.push_back(scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS));
+    oracle.masks.push_back(frames.back().mask);
+  }
+  Tracker tracker(camera, TrackerConfig{}, nullptr);
+  tracker.setMotionFilter(&oracle);
+  int dynamic = 0;
+  for (int i = 0; i < 40; ++i) {
+    const TrackingResult res = tracker.track(makeFrame(frames[static_cast<std::size_t>(i)], i));
+    dynamic += res.dynamic_matches;
+    EXPECT_NE(res.status, FrameStatus::kLost);
+    if (res.is_keyframe) {
+      ASSERT_FALSE(res.keyframe->dynamic_mask.empty());
+      EXPECT_EQ(
+          cv::countNonZero(res.keyframe->dynamic_mask != oracle.masks[static_cast<std::size_t>(i)]),
+          0);
+    }
+  }
+  tracker.finish();
+  EXPECT_EQ(oracle.begun, 40);
+  EXPECT_EQ(oracle.filtered, 40);
+  // No landmark is created on the masked box; only static tracks it occludes can fall inside.
+  EXPECT_GE(dynamic, 0);
+  const auto traj = tracker.finalTrajectory();
+  for (int i = 0; i < 40; ++i) {
+    EXPECT_LT(translationError(traj[static_cast<std::size_t>(i)].second, i), 0.015) << i;
+  }
+}
+
+}  // namespace
+}  // namespace dynamap
