@@ -5,6 +5,40 @@ namespace dynamap {
 void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addString("dynamic.mode", &c.mode, {"off", "geometry", "detector", "both"});
   schema.addDouble("dynamic.epipolar_threshold_px", &c.epipolar_threshold_px, 0.01, 100.0);
+  schema.addInt("dynamic.min_matches", &c.min_matches, 8, 100000);
+  schema.addDouble("dynamic.min_parallax_px", &c.min_parallax_px, 0.0, 1000.0);
+  schema.addDouble("dynamic.ransac_confidence", &c.ransac_confidence, 0.5, 0.999999);
+  schema.addDouble("dynamic.homography_inlier_ratio", &c.homography_inlier_ratio, 0.0, 10.0);
+
+  schema.addString("dynamic.detector", &c.detector,
+                   {"yolo_darknet", "yolov5_onnx", "yolov8_onnx", "nanodet_onnx", "none"});
+  schema.addString("dynamic.model_cfg", &c.model_cfg);
+  schema.addString("dynamic.model_weights", &c.model_weights);
+  schema.addInt("dynamic.input_width", &c.input_width, 32, 4096);
+  schema.addInt("dynamic.input_height", &c.input_height, 32, 4096);
+  schema.addDouble("dynamic.score_threshold", &c.score_threshold, 0.0, 1.0);
+  schema.addDouble("dynamic.high_dynamic_score_threshold", &c.high_dynamic_score_threshold, 0.0,
+                   1.0);
+  schema.addDouble("dynamic.nms_iou_threshold", &c.nms_iou_threshold, 0.0, 1.0);
+  schema.addString("dynamic.nms", &c.nms, {"plain", "recall"});
+  schema.addDouble("dynamic.soft_nms_sigma", &c.soft_nms_sigma, 0.01, 10.0);
+  schema.addInt("dynamic.detector_threads", &c.detector_threads, 0, 256);
+
+  schema.addStringList("dynamic.high_dynamic_classes", &c.high_dynamic_classes);
+  schema.addDouble("dynamic.high_dynamic_weight", &c.high_dynamic_weight, 0.0, 1.0);
+  schema.addDouble("dynamic.low_dynamic_weight", &c.low_dynamic_weight, 0.0, 1.0);
+  schema.addStringMap("dynamic.class_weights", &c.class_weights);
+
+  schema.addDouble("dynamic.moving_ratio", &c.moving_ratio, 0.0, 1.0);
+  schema.addInt("dynamic.min_object_points", &c.min_object_points, 1, 100000);
+  schema.addInt("dynamic.min_dynamic_points", &c.min_dynamic_points, 1, 100000);
+  schema.addInt("dynamic.hold_frames", &c.hold_frames, 0, 1000);
+  schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
+  schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);
+  schema.addDouble("dynamic.cluster_radius_px", &c.cluster_radius_px, 1.0, 1000.0);
+  schema.addInt("dynamic.min_cluster_points", &c.min_cluster_points, 1, 100000);
+  schema.addDouble("dynamic.flood_depth_step_m", &c.flood_depth_step_m, 0.001, 10.0);
+  schema.addDouble("dynamic.cluster_box_margin", &c.cluster_box_margin, 1.0, 10.0);
 }
 
 }  // namespace dynamap

@@ -1,14 +1,71 @@
 #pragma once
 
+#include <map>
 #include <string>
+#include <vector>
 
 namespace dynamap {
 
 /// Motion-area removal parameters, bound to YAML keys "dynamic.<name>"
 /// (tools/io/config_bind_dynamic.cpp).
+///
+/// Model paths: an absolute path is used as is. A relative path is resolved by
+/// resolveDynamicModelPaths(): first against the current working directory, then against the
+/// parent of the config file's directory (so "../shared/models/..." in config/default.yaml means
+/// <repo>/../shared/models/...). The factory checks every path and throws naming the file.
 struct DynamicConfig {
   std::string mode = "both";           ///< off | geometry | detector | both
   double epipolar_threshold_px = 1.0;  ///< matches farther from their epipolar line are dynamic
+
+  // --- geometric check -------------------------------------------------------------------
+  int min_matches = 30;          ///< fewer matches: flag nothing (degenerate)
+  double min_parallax_px = 0.3;  ///< median flow below this: flag nothing (no information)
+  double ransac_confidence = 0.999;
+  /// Homography explains >= this share of the F inliers: low parallax / pure rotation; the
+  /// homography transfer error is used instead of the ill-conditioned epipolar distance.
+  double homography_inlier_ratio = 0.95;
+
+  // --- detector -----------------------------------------------------------------------------
+  std::string detector = "yolo_darknet";  ///< yolo_darknet | yolov5_onnx | yolov8_onnx |
+                                          ///< nanodet_onnx | none
+  std::string model_cfg = "../shared/models/yolo-fastest/yolo-fastest-1.1-xl.cfg";
+  std::string model_weights = "../shared/models/yolo-fastest/yolo-fastest-1.1-xl.weights";
+  int input_width = 320;
+  int input_height = 320;
+  double score_threshold = 0.25;               ///< low-dynamic classes
+  double high_dynamic_score_threshold = 0.15;  ///< high-dynamic classes (recall first)
+  double nms_iou_threshold = 0.45;
+  std::string nms = "recall";   ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)
+  double soft_nms_sigma = 0.5;  ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
+  int detector_threads = 0;     ///< >0: cv::setNumThreads on first detection (process-wide)
+
+  // --- class table --------------------------------------------------------------------------
+  /// COCO names of high-dynamic classes (can move by themselves).
+  std::vector<std::string> high_dynamic_classes{
+      "person",   "bicycle", "car",   "motorcycle", "bus",     "train", "truck",
+      "boat",     "bird",    "cat",   "dog",        "horse",   "sheep", "cow",
+      "elephant", "bear",    "zebra", "giraffe",    "airplane"};
+  double high_dynamic_weight = 1.0;  ///< default prior of a high-dynamic class
+  double low_dynamic_weight = 0.3;   ///< default prior of every other class
+  /// Per-class prior overrides, "dynamic.class_weights.<coco name>: w" (0 = never masked).
+  std::map<std::string, std::string> class_weights{{"person", "1.0"}, {"chair", "0.5"}};
+
+  // --- fusion -------------------------------------------------------------------------------
+  double moving_ratio = 0.2;         ///< weighted share of dynamic points to call an object moving
+  int min_object_points = 4;         ///< tracked points needed inside an object to decide
+  int min_dynamic_points = 3;        ///< dynamic points needed inside an object to call it moving
+  int hold_frames = 3;               ///< a moving object stays moving this many frames w/o evidence
+  double depth_band_m = 0.4;         ///< object pixels: within this of the object's depth mode
+  int mask_dilation_px = 7;          ///< final dilation of each region
+  double cluster_radius_px = 40;     ///< dynamic points closer than this form one cluster
+  int min_cluster_points = 4;        ///< smaller clusters outside detections are noise
+  double flood_depth_step_m = 0.03;  ///< depth continuity of the flood fill from clusters
+  double cluster_box_margin = 1.5;   ///< flood fill stays inside cluster box grown by this
 };
+
+/// Resolves relative model paths (see DynamicConfig): CWD first, then the parent of the
+/// directory of `config_file` (if given). Paths that exist nowhere are left unchanged, so
+/// that the factory's error names them.
+void resolveDynamicModelPaths(DynamicConfig& config, const std::string& config_file);
 
 }  // namespace dynamap

@@ -1,0 +1,80 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/camera.hpp"
+#include "dynamap/core/dynamic/epipolar_check.hpp"
+#include "dynamap/core/dynamic/object_detector.hpp"
+#include "dynamap/core/dynamic/region_fusion.hpp"
+#include "dynamap/core/dynamic_config.hpp"
+#include "dynamap/core/motion_filter.hpp"
+#include "dynamap/core/timing.hpp"
+
+namespace dynamap {
+
+/// Everything the last filter() call saw and decided (for debug images and benchmarks).
+struct MotionDiagnostics {
+  FeatureMatches matches;
+  std::vector<std::uint8_t> epipolar_dynamic;  ///< geometric check per match
+  std::vector<std::uint8_t> match_is_dynamic;  ///< final flag per match
+  EpipolarModel model = EpipolarModel::kNone;
+  std::vector<Detection> detections;  ///< detector output after NMS
+  std::vector<ObjectDecision> objects;
+  int clusters = 0;
+  cv::Mat mask;
+};
+
+/// Motion-area removal: epipolar check + (optional) detector on a worker thread + fusion.
+/// Per-stage durations go to "detector" (on the worker), "epipolar", "fusion" and
+/// "detector_wait" (how long filter() blocked on the detector).
+/// beginFrame()/filter() are called from one (tracking) thread; not otherwise thread-safe.
+class DynamicMotionFilter : public MotionFilter {
+ public:
+  /// Throws DetectorError (naming the file) if the detector cannot be built,
+  /// std::invalid_argument for a bad mode or class table.
+  DynamicMotionFilter(const DynamicConfig& config, const PinholeCamera& camera,
+                      TimingRecorder* timing);
+  ~DynamicMotionFilter() override;
+  DynamicMotionFilter(const DynamicMotionFilter&) = delete;
+  DynamicMotionFilter& operator=(const DynamicMotionFilter&) = delete;
+
+  void beginFrame(const RgbdFrame& frame) override;
+  MotionFilterOutput filter(const MotionFilterInput& input) override;
+
+  const MotionDiagnostics& lastDiagnostics() const { return diagnostics_; }
+  /// Stage durations of this filter (also forwarded to the recorder given at construction).
+  const TimingRecorder& timings() const { return own_timing_; }
+  const ClassTable& classTable() const { return classes_; }
+
+ private:
+  class Worker;
+  void record(const std::string& stage, double ms);
+  std::vector<Detection> waitDetections(const RgbdFrame* frame);
+
+  DynamicConfig config_;
+  FusionMode mode_;
+  ClassTable classes_;
+  RegionFusion fusion_;
+  std::unique_ptr<Worker> worker_;  ///< null when no detector is used
+  TimingRecorder* timing_;
+  TimingRecorder own_timing_;
+  MotionDiagnostics diagnostics_;
+};
+
+/// nullptr for mode "off"; modes geometry | detector | both. Throws like the constructor.
+std::unique_ptr<MotionFilter> makeMotionFilter(const DynamicConfig& config,
+                                               const PinholeCamera& camera, TimingRecorder* timing);
+
+/// Builds the detector options (kind, paths, input size, NMS) from the config.
+DetectorOptions detectorOptions(const DynamicConfig& config);
+
+/// Debug image: features green (static) / red (dynamic) with flow lines, boxes with class and
+/// score (red = moving, yellow = static object), the mask as a red overlay.
+cv::Mat drawMotionDebug(const cv::Mat& bgr, const MotionDiagnostics& diagnostics,
+                        const ClassTable& classes);
+
+}  // namespace dynamap

@@ -1,0 +1,224 @@
+#include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
+
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+namespace dynamap {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+FusionMode parseMode(const std::string& mode) {
+  if (mode == "geometry") return FusionMode::kGeometry;
+  if (mode == "detector") return FusionMode::kDetector;
+  if (mode == "both") return FusionMode::kBoth;
+  throw std::invalid_argument("dynamic.mode: '" + mode +
+                              "' (known: off, geometry, detector, both)");
+}
+
+bool inMask(const cv::Mat& mask, const cv::Point2f& p) {
+  const int x = cvRound(p.x), y = cvRound(p.y);
+  return !mask.empty() && x >= 0 && y >= 0 && x < mask.cols && y < mask.rows &&
+         mask.at<uchar>(y, x) != 0;
+}
+
+}  // namespace
+
+/// Runs the detector on its own thread, one frame in flight.
+class DynamicMotionFilter::Worker {
+ public:
+  Worker(std::unique_ptr<ObjectDetector> detector, int threads, DynamicMotionFilter* owner)
+      : detector_(std::move(detector)),
+        threads_(threads),
+        owner_(owner),
+        thread_([this] { loop(); }) {}
+  ~Worker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  void submit(const cv::Mat& bgr, double stamp) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return !has_job_ && !busy_; });  // finish (and drop) the previous frame
+    job_ = bgr.clone();
+    job_stamp_ = stamp;
+    has_job_ = true;
+    has_result_ = false;
+    cv_.notify_all();
+  }
+  /// Detections of the frame with `stamp`, or std::nullopt-like false if none was submitted.
+  bool collect(double stamp, std::vector<Detection>* out) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!has_job_ && !busy_ && !has_result_) return false;
+    cv_.wait(lock, [&] { return has_result_; });
+    has_result_ = false;
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+    if (result_stamp_ != stamp) return false;
+    *out = std::move(result_);
+    return true;
+  }
+  std::vector<Detection> runNow(const cv::Mat& bgr) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return !has_job_ && !busy_; });
+    has_result_ = false;
+    const auto start = Clock::now();
+    auto dets = detector_->detect(bgr);
+    owner_->record("detector", msSince(start));
+    return dets;
+  }
+
+ private:
+  void loop() {
+    if (threads_ > 0) cv::setNumThreads(threads_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      cv_.wait(lock, [&] { return stop_ || has_job_; });
+      if (stop_) return;
+      cv::Mat job = std::move(job_);
+      const double stamp = job_stamp_;
+      has_job_ = false;
+      busy_ = true;
+      lock.unlock();
+      std::vector<Detection> dets;
+      std::exception_ptr error;
+      const auto start = Clock::now();
+      try {
+        dets = detector_->detect(job);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      owner_->record("detector", msSince(start));
+      lock.lock();
+      result_ = std::move(dets);
+      result_stamp_ = stamp;
+      error_ = error;
+      busy_ = false;
+      has_result_ = true;
+      cv_.notify_all();
+    }
+  }
+
+  std::unique_ptr<ObjectDetector> detector_;
+  int threads_;
+  DynamicMotionFilter* owner_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  cv::Mat job_;
+  double job_stamp_ = 0.0, result_stamp_ = 0.0;
+  bool has_job_ = false, busy_ = false, has_result_ = false, stop_ = false;
+  std::vector<Detection> result_;
+  std::exception_ptr error_;
+  std::thread thread_;  // last: starts after every other member is ready
+};
+
+DetectorOptions detectorOptions(const DynamicConfig& c) {
+  DetectorOptions o;
+  o.kind = c.detector;
+  o.model_cfg = c.model_cfg;
+  o.model_weights = c.model_weights;
+  o.input_width = c.input_width;
+  o.input_height = c.input_height;
+  if (c.nms != "plain" && c.nms != "recall") {
+    throw std::invalid_argument("dynamic.nms: '" + c.nms + "' (known: plain, recall)");
+  }
+  o.nms.kind = c.nms == "plain" ? NmsKind::kPlain : NmsKind::kRecall;
+  o.nms.iou_threshold = static_cast<float>(c.nms_iou_threshold);
+  o.nms.score_threshold = static_cast<float>(c.score_threshold);
+  o.nms.soft_sigma = static_cast<float>(c.soft_nms_sigma);
+  return o;
+}
+
+DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config,
+                                         const PinholeCamera& /*camera*/, TimingRecorder* timing)
+    : config_(config),
+      mode_(parseMode(config.mode)),
+      classes_(config),
+      fusion_(config, classes_),
+      timing_(timing) {
+  if (mode_ != FusionMode::kGeometry && config.detector != "none") {
+    worker_ = std::make_unique<Worker>(makeObjectDetector(detectorOptions(config), classes_),
+                                       config.detector_threads, this);
+  }
+}
+
+DynamicMotionFilter::~DynamicMotionFilter() = default;
+
+void DynamicMotionFilter::record(const std::string& stage, double ms) {
+  own_timing_.add(stage, ms);
+  if (timing_ != nullptr) timing_->add(stage, ms);
+}
+
+void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
+  if (worker_ && !frame.bgr.empty()) worker_->submit(frame.bgr, frame.timestamp_s);
+}
+
+std::vector<Detection> DynamicMotionFilter::waitDetections(const RgbdFrame* frame) {
+  if (!worker_ || frame == nullptr || frame->bgr.empty()) return {};
+  const auto start = Clock::now();
+  std::vector<Detection> dets;
+  const bool ok = worker_->collect(frame->timestamp_s, &dets);
+  record("detector_wait", msSince(start));
+  return ok ? dets : worker_->runNow(frame->bgr);  // beginFrame() was not called for this frame
+}
+
+MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
+  static const FeatureMatches kNoMatches;
+  const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
+  auto start = Clock::now();
+  EpipolarResult epi;
+  if (mode_ != FusionMode::kDetector) {
+    EpipolarOptions eo{config_.epipolar_threshold_px, config_.min_matches, config_.min_parallax_px,
+                       config_.ransac_confidence, config_.homography_inlier_ratio};
+    epi = checkEpipolar(m.prev_px, m.cur_px, eo);
+  }
+  epi.is_dynamic.resize(m.cur_px.size(), 0);
+  record("epipolar", msSince(start));
+
+  auto dets = waitDetections(input.frame);
+
+  start = Clock::now();
+  cv::Mat depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
+  if (depth.empty()) {
+    const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
+    depth = cv::Mat::zeros(size, CV_32FC1);
+  }
+  FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets);
+  MotionFilterOutput out;
+  out.match_is_dynamic.resize(m.cur_px.size(), 0);
+  for (std::size_t i = 0; i < m.cur_px.size(); ++i) {
+    out.match_is_dynamic[i] = (epi.is_dynamic[i] || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
+  }
+  if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
+  record("fusion", msSince(start));
+
+  diagnostics_ = MotionDiagnostics{m,
+                                   epi.is_dynamic,
+                                   out.match_is_dynamic,
+                                   epi.model,
+                                   std::move(dets),
+                                   std::move(fused.objects),
+                                   fused.clusters,
+                                   fused.mask};
+  return out;
+}
+
+std::unique_ptr<MotionFilter> makeMotionFilter(const DynamicConfig& config,
+                                               const PinholeCamera& camera,
+                                               TimingRecorder* timing) {
+  if (config.mode == "off") return nullptr;
+  return std::make_unique<DynamicMotionFilter>(config, camera, timing);
+}
+
+}  // namespace dynamap

@@ -1,0 +1,228 @@
+#include "dynamap/core/dynamic/region_fusion.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+namespace dynamap {
+
+namespace {
+
+constexpr double kBinM = 0.1;
+constexpr int kBins = 100;  // 0..10 m
+
+/// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few.
+double depthMode(const cv::Mat& roi) {
+  std::vector<int> hist(kBins + 2, 0);
+  int total = 0;
+  for (int y = 0; y < roi.rows; y += 2) {
+    const float* row = roi.ptr<float>(y);
+    for (int x = 0; x < roi.cols; x += 2) {
+      const int b = static_cast<int>(row[x] / kBinM);
+      if (row[x] > 0.f && b < kBins) {
+        ++hist[b + 1];
+        ++total;
+      }
+    }
+  }
+  if (total < 20) return 0.0;
+  int best = 1;
+  for (int b = 1; b <= kBins; ++b) {
+    if (hist[b - 1] + 2 * hist[b] + hist[b + 1] > hist[best - 1] + 2 * hist[best] + hist[best + 1])
+      best = b;
+  }
+  const double lo = (best - 2) * kBinM, hi = (best + 1) * kBinM;  // the peak bin +- one bin
+  std::vector<float> vals;
+  for (int y = 0; y < roi.rows; y += 2) {
+    const float* row = roi.ptr<float>(y);
+    for (int x = 0; x < roi.cols; x += 2) {
+      if (row[x] > lo && row[x] < hi) vals.push_back(row[x]);
+    }
+  }
+  std::nth_element(vals.begin(), vals.begin() + vals.size() / 2, vals.end());
+  return vals[vals.size() / 2];
+}
+
+bool inside(const cv::Mat& mask, const cv::Point2f& p) {
+  const int x = cvRound(p.x), y = cvRound(p.y);
+  return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uchar>(y, x) != 0;
+}
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+/// Groups the given points by single linkage with `radius`.
+std::vector<std::vector<int>> clusterPoints(const std::vector<cv::Point2f>& pts,
+                                            const std::vector<int>& ids, double radius) {
+  std::vector<int> parent(ids.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (std::size_t a = 0; a < ids.size(); ++a) {
+    for (std::size_t b = a + 1; b < ids.size(); ++b) {
+      if (cv::norm(pts[ids[a]] - pts[ids[b]]) <= radius) {
+        parent[findRoot(parent, static_cast<int>(a))] = findRoot(parent, static_cast<int>(b));
+      }
+    }
+  }
+  std::vector<std::vector<int>> groups(ids.size());
+  for (std::size_t a = 0; a < ids.size(); ++a)
+    groups[findRoot(parent, static_cast<int>(a))].push_back(ids[a]);
+  groups.erase(
+      std::remove_if(groups.begin(), groups.end(), [](const auto& g) { return g.empty(); }),
+      groups.end());
+  return groups;
+}
+
+cv::Rect clampRect(const cv::Rect2f& r, const cv::Size& size) {
+  return cv::Rect(cv::Point(cvFloor(r.x), cvFloor(r.y)),
+                  cv::Point(cvCeil(r.br().x), cvCeil(r.br().y))) &
+         cv::Rect(cv::Point(0, 0), size);
+}
+
+}  // namespace
+
+cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
+                     double* depth_mode_m) {
+  if (depth_mode_m != nullptr) *depth_mode_m = 0.0;
+  const cv::Rect box = box_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
+  if (box.width < 4 || box.height < 4) return {};
+  const cv::Rect inner(box.x + box.width / 4, box.y + box.height * 15 / 100,
+                       std::max(1, box.width / 2), std::max(1, box.height * 70 / 100));
+  const double mode = depthMode(depth_m(inner));
+  if (mode <= 0.0) return {};
+  if (depth_mode_m != nullptr) *depth_mode_m = mode;
+  cv::Mat sel = (depth_m(box) > mode - band_m) & (depth_m(box) < mode + band_m);
+  cv::morphologyEx(sel, sel, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  cv::Mat labels;
+  const int n = cv::connectedComponents(sel, labels, 8, CV_32S);
+  std::vector<int> votes(n, 0);
+  const cv::Rect inner_local = inner - box.tl();
+  for (int y = inner_local.y; y < inner_local.br().y; ++y) {
+    for (int x = inner_local.x; x < inner_local.br().x; ++x) ++votes[labels.at<int>(y, x)];
+  }
+  votes[0] = 0;
+  const int best = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  if (best > 0) out(box).setTo(255, labels == best);
+  return out;
+}
+
+RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classes)
+    : config_(config), classes_(classes) {}
+
+void RegionFusion::decideObject(ObjectDecision& d, std::vector<Track>& next) {
+  d.moving_now = d.points >= config_.min_object_points &&
+                 d.dynamic_points >= config_.min_dynamic_points &&
+                 d.weight * d.dynamic_points / std::max(1, d.points) >= config_.moving_ratio;
+  int hold = 0;
+  float best_iou = 0.3f;
+  for (const auto& t : tracks_) {
+    const float o = iou(t.box, d.detection.box);
+    if (t.class_id == d.detection.class_id && o > best_iou) {
+      best_iou = o;
+      hold = t.hold;
+    }
+  }
+  hold = d.moving_now ? config_.hold_frames : std::max(0, hold - 1);
+  d.moving = d.moving_now || hold > 0;
+  next.push_back(Track{d.detection.box, d.detection.class_id, hold});
+}
+
+FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
+                                const std::vector<cv::Point2f>& points,
+                                const std::vector<std::uint8_t>& dyn,
+                                const std::vector<Detection>& detections) {
+  FusionResult result;
+  result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
+  std::vector<Track> next;
+  for (const auto& det : detections) {
+    if (mode == FusionMode::kGeometry) break;
+    ObjectDecision d;
+    d.detection = det;
+    d.weight = classes_.weight(det.class_id);
+    if (d.weight <= 0.0) continue;
+    if (mode == FusionMode::kDetector && !classes_.isHighDynamic(det.class_id)) continue;
+    const cv::Rect box = clampRect(det.box, depth_m.size());
+    if (box.area() <= 0) continue;
+    cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m);
+    if (region.empty()) {
+      region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+      region(box).setTo(255);
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!inside(region, points[i])) continue;
+      ++d.points;
+      if (dyn[i]) ++d.dynamic_points;
+    }
+    if (mode == FusionMode::kDetector) {
+      d.moving_now = d.moving = true;
+    } else {
+      decideObject(d, next);
+    }
+    claimed |= region;
+    if (d.moving) result.mask |= region;
+    result.objects.push_back(d);
+  }
+  tracks_ = std::move(next);
+  if (mode != FusionMode::kDetector) {
+    result.clusters = growClusters(depth_m, points, dyn, claimed, result.mask);
+  }
+  if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {
+    const int k = 2 * config_.mask_dilation_px + 1;
+    cv::dilate(result.mask, result.mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  }
+  return result;
+}
+
+int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
+                               const std::vector<std::uint8_t>& dyn, const cv::Mat& claimed,
+                               cv::Mat& mask) const {
+  std::vector<int> free_dyn;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (dyn[i] && !inside(claimed, points[i])) free_dyn.push_back(static_cast<int>(i));
+  }
+  int grown = 0;
+  for (const auto& group : clusterPoints(points, free_dyn, config_.cluster_radius_px)) {
+    if (static_cast<int>(group.size()) < config_.min_cluster_points) continue;
+    std::vector<cv::Point2f> gp;
+    for (int i : group) gp.push_back(points[i]);
+    const cv::Rect tight = cv::boundingRect(gp);
+    // Support: most tracked points around the cluster must be dynamic, else it is noise.
+    const cv::Rect near = cv::Rect(tight.x - 10, tight.y - 10, tight.width + 20, tight.height + 20);
+    int all = 0;
+    for (const auto& p : points) all += near.contains(cv::Point(cvRound(p.x), cvRound(p.y)));
+    if (2 * static_cast<int>(group.size()) < all) continue;
+    const double m = config_.cluster_box_margin;
+    const cv::Point2f c(tight.x + 0.5f * tight.width, tight.y + 0.5f * tight.height);
+    const float hw = static_cast<float>(std::max(40.0, m * tight.width) / 2);
+    const float hh = static_cast<float>(std::max(40.0, m * tight.height) / 2);
+    const cv::Rect roi = clampRect(cv::Rect2f(c.x - hw, c.y - hh, 2 * hw, 2 * hh), depth_m.size());
+    cv::Mat flood = cv::Mat::zeros(roi.height + 2, roi.width + 2, CV_8UC1);
+    flood(cv::Rect(1, 1, roi.width, roi.height)).setTo(1, claimed(roi));  // never grow into objects
+    const cv::Mat depth_roi = depth_m(roi).clone();
+    const double step = config_.flood_depth_step_m;
+    for (int i : group) {
+      const cv::Point s(cvRound(points[i].x) - roi.x, cvRound(points[i].y) - roi.y);
+      if (!cv::Rect(0, 0, roi.width, roi.height).contains(s)) continue;
+      if (depth_roi.at<float>(s) <= 0.f || flood.at<uchar>(s.y + 1, s.x + 1) != 0) continue;
+      cv::floodFill(depth_roi, flood, s, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
+                    8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+    }
+    cv::Mat filled = flood(cv::Rect(1, 1, roi.width, roi.height)) == 255;
+    if (cv::countNonZero(filled) == 0) {  // no depth: the hull of the points
+      std::vector<cv::Point> hull;
+      for (const auto& p : gp) hull.emplace_back(cvRound(p.x), cvRound(p.y));
+      cv::convexHull(std::vector<cv::Point>(hull), hull);
+      cv::fillConvexPoly(mask, hull, 255);
+    } else {
+      mask(roi) |= filled;
+    }
+    ++grown;
+  }
+  return grown;
+}
+
+}  // namespace dynamap
