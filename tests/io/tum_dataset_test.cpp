@@ -114,7 +114,13 @@ TEST(TumSequence, NoHeaderCommasTabsAndMaxFrames) {
   options.max_frames = 2;
   EXPECT_EQ(TumSequence::open(dir.string(), options).size(), 2u);
   options.max_time_diff_s = 0.003;  // depth lags 4 ms -> nothing associates
+  options.keep_unassociated_rgb = false;
   EXPECT_EQ(TumSequence::open(dir.string(), options).size(), 0u);
+  // Kept colour-only frames load with an all-zero depth image.
+  options.keep_unassociated_rgb = true;
+  const TumSequence kept = TumSequence::open(dir.string(), options);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_TRUE(kept.entries()[0].depth_path.empty());
 }
 
 TEST(TumSequence, MissingListFilesAreNamed) {
@@ -184,11 +190,18 @@ TEST(TumSequenceRealData, TeddyAssociatesLikeAssociatePyWithSaneDepth) {
   DYNAMAP_REQUIRE_SHARED_DATA();
   DatasetOptions options;
   options.camera = cameraPreset("freiburg3");
+  options.keep_unassociated_rgb = false;
   const TumSequence seq = TumSequence::open(teddyDir().string(), options);
   // 200 colour and 200 depth images; TUM associate.py (max_difference 0.02) pairs 193 of them
   // (checked with the script's algorithm): 7 colour frames have no free depth within 20 ms,
   // e.g. 1341841877.730182.
   ASSERT_EQ(seq.size(), 193u);
+  options.keep_unassociated_rgb = true;  // the other 7 are kept without depth
+  const TumSequence all = TumSequence::open(teddyDir().string(), options);
+  ASSERT_EQ(all.size(), 200u);
+  std::size_t without_depth = 0;
+  for (const SequenceEntry& e : all.entries()) without_depth += e.depth_path.empty() ? 1 : 0;
+  EXPECT_EQ(without_depth, 7u);
   for (const SequenceEntry& e : seq.entries()) {
     EXPECT_NE(e.rgb_path.find("rgb/"), std::string::npos);
     EXPECT_GT(std::abs(e.rgb_timestamp_s - 1341841877.730182), 1e-4);

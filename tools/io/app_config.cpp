@@ -22,6 +22,7 @@ void bindBaseConfig(ConfigSchema& schema, AppConfig& config) {
   schema.addDouble("camera.depth_scale", &cam.depth_scale, 1.0, 1e6);
   schema.addDouble("dataset.max_time_diff_s", &config.dataset.max_time_diff_s, 0.0, 1.0);
   schema.addInt("dataset.max_frames", &config.dataset.max_frames, 0, 100000000);
+  schema.addBool("dataset.keep_unassociated_rgb", &config.dataset.keep_unassociated_rgb);
 }
 
 void bindAppConfig(ConfigSchema& schema, AppConfig& config) {

@@ -19,6 +19,7 @@ struct CameraSettings {
 struct DatasetSettings {
   double max_time_diff_s = 0.02;  ///< colour/depth association window
   int max_frames = 0;             ///< 0 = all frames
+  bool keep_unassociated_rgb = true;  ///< colour frames without depth are still tracked
 };
 
 /// Everything a run is configured with. Defaults live in the section structs.

@@ -157,10 +157,21 @@ TumSequence TumSequence::open(const std::string& dir, const DatasetOptions& opti
   TumSequence seq;
   seq.directory_ = root.string();
   seq.options_ = options;
+  std::vector<bool> has_depth(rgb.timestamps_s.size(), false);
   for (const auto& [i, j] :
        associateTimestamps(rgb.timestamps_s, depth.timestamps_s, options.max_time_diff_s)) {
     seq.entries_.push_back(
         {rgb.timestamps_s[i], rgb.paths[i], depth.timestamps_s[j], depth.paths[j]});
+    has_depth[i] = true;
+  }
+  if (options.keep_unassociated_rgb) {
+    for (std::size_t i = 0; i < has_depth.size(); ++i) {
+      if (!has_depth[i]) seq.entries_.push_back({rgb.timestamps_s[i], rgb.paths[i], 0.0, ""});
+    }
+    std::sort(seq.entries_.begin(), seq.entries_.end(),
+              [](const SequenceEntry& a, const SequenceEntry& b) {
+                return a.rgb_timestamp_s < b.rgb_timestamp_s;
+              });
   }
   if (options.max_frames > 0 &&
       seq.entries_.size() > static_cast<std::size_t>(options.max_frames)) {
@@ -194,7 +205,9 @@ FrameLoad TumSequence::load(std::size_t index) const {
   const SequenceEntry& entry = entries_[index];
   cv::Mat bgr = readImage(entry.rgb_path, cv::IMREAD_COLOR, &result.error);
   if (bgr.empty()) return result;
-  cv::Mat depth_raw = readImage(entry.depth_path, cv::IMREAD_UNCHANGED, &result.error);
+  cv::Mat depth_raw = entry.depth_path.empty()
+                          ? cv::Mat(cv::Mat::zeros(bgr.size(), CV_16UC1))
+                          : readImage(entry.depth_path, cv::IMREAD_UNCHANGED, &result.error);
   if (depth_raw.empty()) return result;
   if (depth_raw.type() != CV_16UC1) {
     result.error = "depth image " + entry.depth_path + " is not 16-bit single-channel (" +

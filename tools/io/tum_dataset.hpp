@@ -25,9 +25,13 @@ struct DatasetOptions {
   double depth_scale = 5000.0;    ///< depth PNG units per metre
   PinholeCamera camera;           ///< distortion != 0 -> frames are undistorted on load
   int max_frames = 0;             ///< 0 = all associated frames
+  /// Keep colour frames that found no depth within the window (TUM sequences have a few):
+  /// they load with an all-zero depth image, so the tracker still gives them a pose.
+  bool keep_unassociated_rgb = true;
 };
 
-/// One associated colour + depth pair. Paths are absolute.
+/// One associated colour + depth pair. Paths are absolute. `depth_path` is empty for a colour
+/// frame kept without depth (DatasetOptions::keep_unassociated_rgb).
 struct SequenceEntry {
   double rgb_timestamp_s;
   std::string rgb_path;

@@ -37,15 +37,6 @@ namespace {
 
 constexpr std::size_t kMappingQueueCapacity = 16;
 
-std::map<std::string, std::string> backendParams(const MappingConfig& mapping) {
-  std::map<std::string, std::string> params;
-  const std::string prefix = mapping.backend + ".";
-  for (const auto& [key, value] : mapping.params) {
-    if (key.rfind(prefix, 0) == 0) params[key.substr(prefix.size())] = value;
-  }
-  return params;
-}
-
 std::string stampName(const std::string& rgb_path) { return fs::path(rgb_path).stem().string(); }
 
 class ProgressLine {
@@ -83,7 +74,8 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
 
   // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
   const auto registry = BackendRegistry::scan(pluginSearchPath());
-  auto backend = registry.create(config_.mapping.backend, backendParams(config_.mapping));
+  auto backend = registry.create(config_.mapping.backend,
+                                 paramsForBackend(config_.mapping.params, config_.mapping.backend));
   s.mapper = std::make_unique<MappingWorker>(std::move(backend), s.camera, StaticPointsOptions{},
                                              kMappingQueueCapacity, &timings_);
 

@@ -1,21 +1,12 @@
 #include "plugin_paths.hpp"
 
-#include <cstdlib>
 #include <filesystem>
-#include <sstream>
 
 namespace dynamap {
 
 std::vector<std::string> pluginSearchPath() {
   namespace fs = std::filesystem;
   std::vector<std::string> dirs;
-  if (const char* env = std::getenv("DYNAMAP_PLUGIN_PATH")) {
-    std::stringstream ss(env);
-    std::string dir;
-    while (std::getline(ss, dir, ':')) {
-      if (!dir.empty()) dirs.push_back(dir);
-    }
-  }
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {

@@ -5,8 +5,8 @@
 
 namespace dynamap {
 
-/// Folders searched for mapping-backend plugins, in order: $DYNAMAP_PLUGIN_PATH
-/// (colon-separated), <exe>/../lib/dynamap, <exe>/../lib, then the build tree's lib folder.
+/// Folders searched for mapping-backend plugins besides $DYNAMAP_PLUGIN_PATH (which
+/// BackendRegistry adds itself): <exe>/../lib/dynamap, <exe>/../lib, the build tree's lib.
 std::vector<std::string> pluginSearchPath();
 
 }  // namespace dynamap
