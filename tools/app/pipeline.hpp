@@ -31,7 +31,7 @@ struct RunResult {
   std::string status = "complete";  ///< complete | interrupted | failed
   std::string error;
   RunCounts counts;
-  std::vector<TimedPose> trajectory;  ///< every frame with a pose, final optimised poses
+  std::vector<TimedPose> trajectory;      ///< every frame with a pose, final optimised poses
   std::vector<std::string> frame_status;  ///< parallel to trajectory
   std::vector<TimedPose> keyframes;
   double wall_time_s = 0.0;

@@ -7,8 +7,8 @@ namespace dynamap {
 
 /// What `dynamap run` was asked to do.
 struct RunOptions {
-  std::string config_path;              ///< empty = config/default.yaml defaults only
-  std::vector<std::string> overrides;   ///< "--set section.key=value"
+  std::string config_path;             ///< empty = config/default.yaml defaults only
+  std::vector<std::string> overrides;  ///< "--set section.key=value"
   std::string sequence_dir;
   std::string out_dir;
   std::string poses_file;  ///< map with these TUM poses instead of tracking

@@ -100,8 +100,9 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
       report.evaluation = evaluateTrajectories(gt, result.trajectory, TrajectoryEvalOptions{});
       alignment = report.evaluation->ate.alignment;
       metrics_json = evaluationToJson(*report.evaluation);
-      writeTrajectoryPlot(outPath(options, "trajectory.png"), report.evaluation->ate,
-                          "dynamap: " + fs::path(options.sequence_dir).filename().string());
+      TrajectoryPlotOptions plot;
+      plot.title = "dynamap: " + fs::path(options.sequence_dir).filename().string();
+      writeTrajectoryPlot(outPath(options, "trajectory.png"), gt, report.evaluation->ate, plot);
     } catch (const std::exception& e) {
       report.warnings += std::string("trajectory evaluation skipped: ") + e.what() + "\n";
     }

@@ -1,21 +1,21 @@
 #include "pipeline.hpp"
 
+#include <unistd.h>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "dynamap/core/dynamic/motion_filter_factory.hpp"
+#include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "dynamap/mapping/backend_registry.hpp"
 #include "dynamap/mapping/mapping_worker.hpp"
 #include "given_masks.hpp"
 #include "image_io.hpp"
-#include "output_files.hpp"
 #include "interrupt.hpp"
+#include "output_files.hpp"
 #include "plugin_paths.hpp"
 #include "pose_lookup.hpp"
 
@@ -26,8 +26,8 @@ namespace fs = std::filesystem;
 struct Pipeline::Stages {
   PinholeCamera camera;
   std::unique_ptr<MotionFilter> motion_filter;
-  GivenMaskFilter* given_masks = nullptr;  // == motion_filter.get() with --masks
-  std::unique_ptr<Tracker> tracker;        // null with --poses
+  GivenMaskFilter* given_masks = nullptr;   // == motion_filter.get() with --masks
+  std::unique_ptr<Tracker> tracker;         // null with --poses
   std::unique_ptr<PoseLookup> given_poses;  // set with --poses
   std::unique_ptr<MappingWorker> mapper;
   std::uint64_t next_keyframe_id = 0;
@@ -126,8 +126,7 @@ void Pipeline::processFrames(RunResult& result) {
   for (std::size_t i = 0; i < total; ++i) {
     if (interruptRequested()) {
       result.status = "interrupted";
-      std::fprintf(stderr, "\ninterrupted at frame %zu/%zu: writing what was computed\n", i,
-                   total);
+      std::fprintf(stderr, "\ninterrupted at frame %zu/%zu: writing what was computed\n", i, total);
       return;
     }
     processFrame(i, result);

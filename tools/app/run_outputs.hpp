@@ -15,7 +15,7 @@ namespace dynamap {
 /// What writeRunOutputs computed (for the summary printed at the end).
 struct RunReport {
   std::optional<TrajectoryEvaluation> evaluation;  ///< when the sequence has ground truth
-  std::string map_metrics_json;                     ///< when reference clouds exist
+  std::string map_metrics_json;                    ///< when reference clouds exist
   double frames_per_s = 0.0;
   std::string warnings;
 };

@@ -1,0 +1,35 @@
+#include "map_report.hpp"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "json_writer.hpp"
+#include "map_metrics.hpp"
+
+namespace dynamap {
+namespace fs = std::filesystem;
+
+std::string mapMetricsJson(const std::string& sequence_dir, const std::string& map_dir,
+                           const Alignment& alignment) {
+  if (!fs::exists(fs::path(sequence_dir) / "reference_static.ply")) return "";
+  fs::path map_file = fs::path(map_dir) / "cloud.ply";
+  if (!fs::exists(map_file)) map_file = fs::path(map_dir) / "mesh.ply";
+  if (!fs::exists(map_file)) throw std::runtime_error(map_dir + ": no cloud.ply or mesh.ply");
+
+  const ReferenceClouds refs = loadReferenceClouds(sequence_dir);
+  Eigen::Isometry3d T_ref_map = Eigen::Isometry3d::Identity();
+  T_ref_map.linear() = alignment.scale * alignment.R;  // scale is 1 for a rigid alignment
+  T_ref_map.translation() = alignment.t;
+  const MapMetrics m = computeMapMetrics(readPlyVertices(map_file.string()), refs, T_ref_map);
+  JsonObject json;
+  json.add("file", map_file.filename().string())
+      .add("map_points_1cm", static_cast<std::uint64_t>(m.map_points))
+      .add("accuracy_mean_m", m.accuracy_mean_m)
+      .add("precision", m.precision)
+      .add("completeness", m.completeness)
+      .add("fscore", m.fscore)
+      .add("ghost_ratio", m.ghost_ratio);
+  return json.str();
+}
+
+}  // namespace dynamap
