@@ -50,7 +50,12 @@ std::string tickLabel(double value, double step) {
 void putTextCentered(cv::Mat& img, const std::string& text, cv::Point center, double scale,
                      int thickness = 1, cv::Scalar colour = kBlack) {
   int baseline = 0;
-  const cv::Size size = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  cv::Size size = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  const int max_width = img.cols - 20;  // shrink long text (e.g. titles) to fit the image
+  if (size.width > max_width) {
+    scale *= static_cast<double>(max_width) / size.width;
+    size = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  }
   cv::putText(img, text, {center.x - size.width / 2, center.y + size.height / 2}, kFont, scale,
               colour, thickness, kLineAa);
 }
@@ -171,7 +176,12 @@ cv::Mat renderTrajectoryPlot(const std::vector<TimedPose>& gt, const AteResult& 
                              const TrajectoryPlotOptions& options) {
   cv::Mat img(options.height, options.width, CV_8UC3, kWhite);
   std::vector<Eigen::Vector3d> gt_points;
-  for (const TimedPose& p : gt) gt_points.push_back(p.T_W_C.translation());
+  // Ground truth over the time span of the associated pairs only, not the whole recording.
+  const double t0 = ate.timestamps_s.empty() ? -1e300 : ate.timestamps_s.front();
+  const double t1 = ate.timestamps_s.empty() ? 1e300 : ate.timestamps_s.back();
+  for (const TimedPose& p : gt) {
+    if (p.timestamp_s >= t0 && p.timestamp_s <= t1) gt_points.push_back(p.T_W_C.translation());
+  }
   if (gt_points.empty()) gt_points = ate.gt_positions_m;
   std::vector<Eigen::Vector3d> all_points = gt_points;
   all_points.insert(all_points.end(), ate.est_aligned_m.begin(), ate.est_aligned_m.end());
