@@ -1,7 +1,8 @@
 // `pcl_voxel`: an incrementally voxel-filtered cloud. Each keyframe's points are added to a hash
 // map voxel key -> running centroid/colour (never re-filtering the whole map). For pose updates,
-// each keyframe also keeps its points reduced to voxel centroids in the camera frame; a moved
+// each keyframe also keeps its points reduced to voxel centroids (camera frame); a moved
 // keyframe marks the map dirty and export rebuilds the hash from those (cheap: reduced clouds).
+#include <algorithm>
 #include <unordered_map>
 
 #include <pcl/filters/statistical_outlier_removal.h>
@@ -31,19 +32,33 @@ class PclVoxelBackend final : public MapBackend {
   void integrate(const KeyframeView& view) override {
     const Eigen::Isometry3f T = view.T_W_C.cast<float>();
     const auto& pts = *view.points_C;
-    VoxelMap local;  // camera-frame reduction kept for pose updates
-    local.reserve(pts.size() / 4);
+    // Sort the keyframe's points by world voxel: one hash access per distinct voxel, and the
+    // same runs give the keyframe's own reduced cloud (kept in the camera frame for pose updates).
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(pts.size());
+    std::vector<Eigen::Vector3f> p_W(pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      const std::uint8_t* rgb = (*view.colors)[i].data();
-      const Eigen::Vector3f p_W = T * pts[i];
-      map_[plugin::voxelKey(p_W, inv_voxel_)].add(p_W, rgb);
-      local[plugin::voxelKey(pts[i], inv_voxel_)].add(pts[i], rgb);
+      p_W[i] = T * pts[i];
+      keyed[i] = {plugin::voxelKey(p_W[i], inv_voxel_), static_cast<std::uint32_t>(i)};
     }
+    std::sort(keyed.begin(), keyed.end());
     Keyframe kf;
     kf.T_W_C = view.T_W_C;
     kf.T_integrated = view.T_W_C;
-    kf.voxels.reserve(local.size());
-    for (const auto& kv : local) kf.voxels.push_back(kv.second);
+    const Eigen::Isometry3f T_C_W = T.inverse();
+    for (std::size_t b = 0; b < keyed.size();) {
+      plugin::VoxelAccum run;
+      std::size_t e = b;
+      for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
+        run.add(p_W[keyed[e].second], (*view.colors)[keyed[e].second].data());
+      }
+      plugin::VoxelAccum& dst = map_[keyed[b].first];
+      dst.sum += run.sum;
+      for (int k = 0; k < 3; ++k) dst.rgb_sum[k] += run.rgb_sum[k];
+      dst.count += run.count;
+      run.sum = (T_C_W * (run.sum / static_cast<float>(run.count))) * static_cast<float>(run.count);
+      kf.voxels.push_back(run);
+      b = e;
+    }
     keyframes_[view.id] = std::move(kf);
   }
 

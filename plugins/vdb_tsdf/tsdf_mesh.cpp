@@ -8,7 +8,7 @@
 namespace dynamap::plugin {
 namespace {
 
-// True when all 8 voxels of the cell holding index-space point q carry at least min_weight:
+// True when all 8 voxels of the cell holding index-space point q weigh more than min_weight:
 // drops the spurious faces between observed and never-observed voxels.
 template <typename Accessor>
 bool cellObserved(Accessor& weights, const openvdb::Vec3s& q, float min_weight) {
@@ -18,7 +18,7 @@ bool cellObserved(Accessor& weights, const openvdb::Vec3s& q, float min_weight) 
   for (int dx = 0; dx < 2; ++dx) {
     for (int dy = 0; dy < 2; ++dy) {
       for (int dz = 0; dz < 2; ++dz) {
-        if (weights.getValue(base.offsetBy(dx, dy, dz)) < min_weight) return false;
+        if (!(weights.getValue(base.offsetBy(dx, dy, dz)) > min_weight)) return false;
       }
     }
   }

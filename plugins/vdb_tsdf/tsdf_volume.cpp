@@ -8,6 +8,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 namespace dynamap::plugin {
 namespace {
@@ -121,16 +122,13 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
   std::vector<FloatLeaf*> tsdf_leaves(blocks.size());
   std::vector<FloatLeaf*> weight_leaves(blocks.size());
   std::vector<ColorLeaf*> color_leaves(blocks.size());
-  {
-    auto ta = tsdf_->getAccessor();
-    auto wa = weight_->getAccessor();
-    auto ca = color_->getAccessor();
-    for (std::size_t i = 0; i < blocks.size(); ++i) {
-      tsdf_leaves[i] = ta.touchLeaf(blocks[i]);
-      weight_leaves[i] = wa.touchLeaf(blocks[i]);
-      color_leaves[i] = ca.touchLeaf(blocks[i]);
-    }
-  }
+  // Each grid's tree is touched by one thread (trees are not safe for concurrent writes).
+  auto touch = [&blocks](auto& grid, auto& leaves) {
+    auto acc = grid.getAccessor();
+    for (std::size_t i = 0; i < blocks.size(); ++i) leaves[i] = acc.touchLeaf(blocks[i]);
+  };
+  tbb::parallel_invoke([&] { touch(*tsdf_, tsdf_leaves); }, [&] { touch(*weight_, weight_leaves); },
+                       [&] { touch(*color_, color_leaves); });
   const Eigen::Isometry3d T_C_W = T_W_C.inverse();
   const Eigen::Matrix3f R = T_C_W.rotation().cast<float>();
   const Eigen::Vector3f t = T_C_W.translation().cast<float>();

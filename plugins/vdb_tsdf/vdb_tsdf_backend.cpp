@@ -22,11 +22,11 @@ plugin::TsdfOptions readOptions(const BackendParams& params) {
     throw MappingError("mapping.params.vdb_tsdf.truncation_m: must be >= voxel_size_m");
   }
   o.max_weight = static_cast<float>(reader.getDouble("max_weight", 100.0, 1.0, 1e6));
-  o.min_weight = static_cast<float>(reader.getDouble("min_weight", 1.0, 0.0, 1e6));
+  o.min_weight = static_cast<float>(reader.getDouble("min_weight", 0.0, 0.0, 1e6));
   o.space_carving = reader.getBool("space_carving", true);
   o.linear_weighting = reader.getString("weighting", "linear", {"constant", "linear"}) == "linear";
-  o.alloc_stride_px = reader.getInt("alloc_stride_px", 2, 1, 64);
-  o.carve_stride_px = reader.getInt("carve_stride_px", 8, 1, 256);
+  o.alloc_stride_px = reader.getInt("alloc_stride_px", 4, 1, 64);
+  o.carve_stride_px = reader.getInt("carve_stride_px", 12, 1, 256);
   reader.finish();
   return o;
 }

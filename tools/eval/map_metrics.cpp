@@ -1,0 +1,172 @@
+#include "map_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <thread>
+#include <unordered_map>
+
+#include "dynamap/mapping/ply_io.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr std::uint32_t kLeafSize = 8;
+
+// Runs fn(i) for i in [0, n) on two threads (the machines have 2 cores).
+template <typename Fn>
+void parallelFor(std::size_t n, const Fn& fn) {
+  const std::size_t half = n / 2;
+  std::thread t([&] {
+    for (std::size_t i = 0; i < half; ++i) fn(i);
+  });
+  for (std::size_t i = half; i < n; ++i) fn(i);
+  t.join();
+}
+
+}  // namespace
+
+PointIndex::PointIndex(std::vector<Eigen::Vector3f> points) : points_(std::move(points)) {
+  nodes_.reserve(2 * points_.size() / kLeafSize + 2);
+  if (!points_.empty()) build(0, static_cast<std::uint32_t>(points_.size()));
+}
+
+std::uint32_t PointIndex::build(std::uint32_t begin, std::uint32_t end) {
+  const auto id = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  if (end - begin <= kLeafSize) {
+    nodes_[id].begin = begin;
+    nodes_[id].end = end;
+    return id;
+  }
+  Eigen::Vector3f lo = points_[begin], hi = points_[begin];
+  for (std::uint32_t i = begin; i < end; ++i) {
+    lo = lo.cwiseMin(points_[i]);
+    hi = hi.cwiseMax(points_[i]);
+  }
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const std::uint32_t mid = begin + (end - begin) / 2;
+  std::nth_element(
+      points_.begin() + begin, points_.begin() + mid, points_.begin() + end,
+      [axis](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a[axis] < b[axis]; });
+  const float split = points_[mid][axis];
+  const std::uint32_t left = build(begin, mid);
+  const std::uint32_t right = build(mid, end);
+  nodes_[id].axis = axis;
+  nodes_[id].split = split;
+  nodes_[id].left = left;
+  nodes_[id].right = right;
+  return id;
+}
+
+void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float* best_sq) const {
+  const Node& n = nodes_[node];
+  if (n.axis < 0) {
+    for (std::uint32_t i = n.begin; i < n.end; ++i) {
+      *best_sq = std::min(*best_sq, (points_[i] - q).squaredNorm());
+    }
+    return;
+  }
+  const float diff = q[n.axis] - n.split;
+  const std::uint32_t near = diff < 0 ? n.left : n.right;
+  const std::uint32_t far = diff < 0 ? n.right : n.left;
+  search(near, q, best_sq);
+  if (diff * diff < *best_sq) search(far, q, best_sq);
+}
+
+float PointIndex::nearestDistance(const Eigen::Vector3f& q) const {
+  if (points_.empty()) return std::numeric_limits<float>::infinity();
+  float best = std::numeric_limits<float>::infinity();
+  search(0, q, &best);
+  return std::sqrt(best);
+}
+
+std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& points,
+                                            double voxel_m) {
+  struct Acc {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int n = 0;
+  };
+  std::unordered_map<std::uint64_t, Acc> voxels;
+  voxels.reserve(points.size() / 2);
+  const double inv = 1.0 / voxel_m;
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    const auto k = [&](float v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
+                                        (1 << 20)) &
+             ((1u << 21) - 1);
+    };
+    Acc& a = voxels[k(p.x()) | (k(p.y()) << 21) | (k(p.z()) << 42)];
+    a.sum += p.cast<double>();
+    ++a.n;
+  }
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(voxels.size());
+  for (const auto& kv : voxels) out.emplace_back((kv.second.sum / kv.second.n).cast<float>());
+  return out;
+}
+
+std::vector<Eigen::Vector3f> readPlyVertices(const std::string& path) {
+  return readPly(path).vertices;
+}
+
+ReferenceClouds loadReferenceClouds(const std::string& dir) {
+  namespace fs = std::filesystem;
+  ReferenceClouds refs;
+  refs.static_points = readPlyVertices((fs::path(dir) / "reference_static.ply").string());
+  refs.static_ref = std::make_shared<PointIndex>(refs.static_points);
+  const fs::path dyn = fs::path(dir) / "reference_dynamic.ply";
+  if (fs::exists(dyn))
+    refs.dynamic_ref = std::make_shared<PointIndex>(readPlyVertices(dyn.string()));
+  return refs;
+}
+
+MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
+                             const ReferenceClouds& refs, const Eigen::Isometry3d& T_ref_map,
+                             const MapMetricsOptions& options) {
+  std::vector<Eigen::Vector3f> moved;
+  moved.reserve(map_points_W.size());
+  const Eigen::Isometry3f T = T_ref_map.cast<float>();
+  for (const auto& p : map_points_W) moved.push_back(T * p);
+  const std::vector<Eigen::Vector3f> map = voxelCentroids(moved, options.voxel_m);
+  MapMetrics m;
+  m.map_points = map.size();
+  if (map.empty() || !refs.static_ref) return m;
+  const auto thr = static_cast<float>(options.threshold_m);
+  const auto ghost_thr = static_cast<float>(options.ghost_dynamic_m);
+  std::vector<float> d_static(map.size());
+  std::vector<char> ghost(map.size(), 0);
+  parallelFor(map.size(), [&](std::size_t i) {
+    d_static[i] = refs.static_ref->nearestDistance(map[i]);
+    if (d_static[i] > thr && refs.dynamic_ref) {
+      ghost[i] = refs.dynamic_ref->nearestDistance(map[i]) <= ghost_thr ? 1 : 0;
+    }
+  });
+  double sum = 0.0;
+  std::size_t close = 0, ghosts = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    sum += d_static[i];
+    close += d_static[i] <= thr ? 1 : 0;
+    ghosts += ghost[i];
+  }
+  m.accuracy_mean_m = sum / map.size();
+  m.precision = static_cast<double>(close) / map.size();
+  m.ghost_ratio = static_cast<double>(ghosts) / map.size();
+  const PointIndex map_index(map);
+  std::vector<char> covered(refs.static_points.size(), 0);
+  parallelFor(refs.static_points.size(), [&](std::size_t i) {
+    covered[i] = map_index.nearestDistance(refs.static_points[i]) <= thr ? 1 : 0;
+  });
+  std::size_t n_covered = 0;
+  for (const char c : covered) n_covered += c;
+  m.completeness =
+      refs.static_points.empty() ? 0.0 : static_cast<double>(n_covered) / refs.static_points.size();
+  const double ps = m.precision + m.completeness;
+  m.fscore = ps > 0 ? 2.0 * m.precision * m.completeness / ps : 0.0;
+  return m;
+}
+
+}  // namespace dynamap

@@ -1,0 +1,73 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace dynamap {
+
+/// Nearest-neighbour index over a fixed point set (a small k-d tree; no PCL). Thread-safe queries.
+class PointIndex {
+ public:
+  explicit PointIndex(std::vector<Eigen::Vector3f> points);
+  /// Distance to the nearest point (infinity when empty).
+  float nearestDistance(const Eigen::Vector3f& q) const;
+  std::size_t size() const { return points_.size(); }
+
+ private:
+  struct Node {
+    int axis = -1;  ///< -1 = leaf
+    float split = 0.0f;
+    std::uint32_t begin = 0, end = 0;  ///< leaf range
+    std::uint32_t left = 0, right = 0;
+  };
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end);
+  void search(std::uint32_t node, const Eigen::Vector3f& q, float* best_sq) const;
+  std::vector<Eigen::Vector3f> points_;
+  std::vector<Node> nodes_;
+};
+
+/// The references of the dynamic sequences (shared/data/dynamic/README.md), kd-indexed.
+struct ReferenceClouds {
+  std::shared_ptr<const PointIndex> static_ref;   ///< reference_static.ply
+  std::shared_ptr<const PointIndex> dynamic_ref;  ///< reference_dynamic.ply (may be null)
+  std::vector<Eigen::Vector3f> static_points;     ///< for completeness
+};
+/// Reads <dir>/reference_static.ply and <dir>/reference_dynamic.ply (if present).
+ReferenceClouds loadReferenceClouds(const std::string& dir);
+
+struct MapMetrics {
+  std::size_t map_points = 0;  ///< after the 1 cm voxel reduction
+  double accuracy_mean_m = 0.0;
+  double precision = 0.0;
+  double completeness = 0.0;
+  double fscore = 0.0;
+  double ghost_ratio = 0.0;
+};
+
+struct MapMetricsOptions {
+  double voxel_m = 0.01;          ///< map reduced to one centroid per voxel
+  double threshold_m = 0.05;      ///< precision / completeness / ghost static distance
+  double ghost_dynamic_m = 0.03;  ///< ghost: within this of the dynamic reference
+};
+
+/// README "Metrics": moves the map by T_ref_map, reduces it to 1 cm voxel centroids, then
+/// accuracy (mean NN distance to the static reference), precision, completeness, F-score and
+/// ghost ratio (within 3 cm of the dynamic reference and more than 5 cm from the static one).
+MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
+                             const ReferenceClouds& refs,
+                             const Eigen::Isometry3d& T_ref_map = Eigen::Isometry3d::Identity(),
+                             const MapMetricsOptions& options = {});
+
+/// One centroid per voxel of size voxel_m.
+std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& points,
+                                            double voxel_m);
+
+/// Vertices of a PLY file (point cloud or mesh; ASCII or binary_little_endian; extra properties
+/// ignored). Throws std::runtime_error naming the file.
+std::vector<Eigen::Vector3f> readPlyVertices(const std::string& path);
+
+}  // namespace dynamap
