@@ -89,7 +89,7 @@ struct ModeSummary {
 };
 
 ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::DynSequence& seq,
-                    int first, int count, const std::string& debug_dir) {
+                    int first, int count, const std::string& debug_dir, bool verbose) {
   c.mode = mode;
   DynamicMotionFilter filter(c, PinholeCamera{}, nullptr);
   TimingRecorder lk_timing;
@@ -97,7 +97,8 @@ ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::Dy
   int iou_n = 0;
   long st = 0, st_m = 0, td = 0, td_m = 0;
   long pts[3] = {0, 0, 0}, pts_dyn[3] = {0, 0, 0};
-  int model_count[3] = {0, 0, 0};
+  int model_count[4] = {0, 0, 0, 0};
+  std::vector<double> residuals[3];
   dynbench::SequenceFrame prev = seq.load(first);
   const int last = std::min<int>(static_cast<int>(seq.size()) - 1, first + count);
   for (int i = first + 1; i <= last; ++i) {
@@ -110,6 +111,33 @@ ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::Dy
     const auto s = dynbench::scoreMask(out.dynamic_mask, cur.gt_mask, cur.teddy_mask);
     if (s.moving_visible) iou_sum += s.iou, ++iou_n;
     const auto& diag = filter.lastDiagnostics();
+    if (verbose) {
+      std::vector<double> r[3];
+      for (std::size_t k = 0; k < matches.cur_px.size() && k < diag.residual_px.size(); ++k) {
+        const uchar g =
+            cur.gt_mask.at<uchar>(cvRound(matches.cur_px[k].y), cvRound(matches.cur_px[k].x));
+        r[g == 255 ? 0 : (g == 128 ? 1 : 2)].push_back(diag.residual_px[k]);
+      }
+      auto med = [](std::vector<double> v) { return v.empty() ? -1.0 : percentile(v, 50); };
+      std::printf(
+          "  frame %d iou %.2f standing %.2f teddy %.2f | median residual moving %.1f (%zu) "
+          "standing %.1f (%zu) static %.1f (%zu)\n",
+          i, s.iou, s.standing_masked, s.teddy_masked, med(r[0]), r[0].size(), med(r[1]),
+          r[1].size(), med(r[2]), r[2].size());
+      for (const auto& o : diag.objects) {
+        const cv::Rect b = cv::Rect(o.detection.box) & cv::Rect(0, 0, 640, 480);
+        const double st_share =
+            b.area() ? cv::countNonZero(cur.gt_mask(b) == 128) / double(b.area()) : 0.0;
+        const double mv_share =
+            b.area() ? cv::countNonZero(cur.gt_mask(b) == 255) / double(b.area()) : 0.0;
+        std::printf(
+            "     obj %s %.2f pts %d dyn %d now %d moving %d depth %.2f | box standing %.2f moving "
+            "%.2f\n",
+            filter.classTable().name(o.detection.class_id).c_str(), o.detection.score, o.points,
+            o.dynamic_points, o.moving_now, o.moving, o.depth_m, st_share, mv_share);
+      }
+      std::printf("     clusters %d\n", diag.clusters);
+    }
     ++model_count[static_cast<int>(diag.model)];
     for (std::size_t k = 0; k < matches.cur_px.size(); ++k) {
       const uchar g =
@@ -117,6 +145,7 @@ ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::Dy
       const int cls = g == 255 ? 0 : (g == 128 ? 1 : 2);
       ++pts[cls];
       pts_dyn[cls] += diag.epipolar_dynamic[k];
+      if (k < diag.residual_px.size()) residuals[cls].push_back(diag.residual_px[k]);
     }
     st += s.standing_px, st_m += s.standing_masked_px, td += s.teddy_px, td_m += s.teddy_masked_px;
     if (!debug_dir.empty()) {
@@ -136,10 +165,18 @@ ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::Dy
   std::printf(
       "  epipolar flags: moving-person points %ld/%ld (%.3f), standing %ld/%ld (%.3f), static "
       "%ld/%ld "
-      "(%.3f); frames none/F/H = %d/%d/%d\n",
+      "(%.3f); frames none/F/H/rigid = %d/%d/%d/%d\n",
       pts_dyn[0], pts[0], double(pts_dyn[0]) / std::max(1L, pts[0]), pts_dyn[1], pts[1],
       double(pts_dyn[1]) / std::max(1L, pts[1]), pts_dyn[2], pts[2],
-      double(pts_dyn[2]) / std::max(1L, pts[2]), model_count[0], model_count[1], model_count[2]);
+      double(pts_dyn[2]) / std::max(1L, pts[2]), model_count[0], model_count[1], model_count[2],
+      model_count[3]);
+  for (int c = 0; c < 3; ++c) {
+    if (residuals[c].empty()) continue;
+    std::printf("  residual px (%s): p25 %.2f p50 %.2f p75 %.2f p90 %.2f\n",
+                c == 0 ? "moving" : (c == 1 ? "standing" : "static"), percentile(residuals[c], 25),
+                percentile(residuals[c], 50), percentile(residuals[c], 75),
+                percentile(residuals[c], 90));
+  }
   return m;
 }
 
@@ -151,7 +188,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> modes{"geometry", "detector", "both"};
   int first = 0, count = 199;
   std::string debug_dir, nms = "recall";
-  bool recall_only = false, no_recall = false;
+  bool recall_only = false, no_recall = false, verbose = false;
+  app.add_flag("--verbose", verbose, "one line per frame");
   app.add_option("--shared", shared, "the shared data/models folder");
   app.add_option("--modes", modes, "modes to run")->delimiter(',');
   app.add_option("--first", first, "first frame");
@@ -160,9 +198,23 @@ int main(int argc, char** argv) {
   app.add_option("--debug-dir", debug_dir, "write debug images here");
   app.add_flag("--recall-only", recall_only, "only the detector recall evaluation");
   app.add_flag("--no-recall", no_recall, "skip the detector recall evaluation");
+  DynamicConfig config;
+  app.add_option("--epipolar-threshold", config.epipolar_threshold_px,
+                 "dynamic.epipolar_threshold_px");
+  app.add_option("--reprojection-threshold", config.reprojection_threshold_px,
+                 "dynamic.reprojection_threshold_px");
+  app.add_option("--rigid-epipolar-threshold", config.rigid_epipolar_threshold_px,
+                 "dynamic.rigid_epipolar_threshold_px");
+  app.add_option("--moving-ratio", config.moving_ratio, "dynamic.moving_ratio");
+  app.add_option("--evidence-smoothing", config.evidence_smoothing, "dynamic.evidence_smoothing");
+  app.add_option("--geometric-check", config.geometric_check, "rigid | epipolar");
+  app.add_option("--detector", config.detector, "yolo_darknet | nanodet_onnx | ... | none");
+  app.add_option("--model-cfg", config.model_cfg, "dynamic.model_cfg");
+  app.add_option("--model-weights", config.model_weights, "dynamic.model_weights");
+  app.add_option("--input-size", config.input_width, "square detector input")
+      ->each([&](const std::string&) { config.input_height = config.input_width; });
   CLI11_PARSE(app, argc, argv);
   try {
-    DynamicConfig config;
     config.nms = nms;
     resolveDynamicModelPaths(config,
                              (fs::path(DYNAMAP_SOURCE_DIR) / "config" / "default.yaml").string());
@@ -173,7 +225,7 @@ int main(int argc, char** argv) {
     if (recall_only) return 0;
     if (!debug_dir.empty()) fs::create_directories(debug_dir);
     const dynbench::DynSequence seq(shared / "data/dynamic/teddy_dyn_dev");
-    for (const auto& mode : modes) runMode(config, mode, seq, first, count, debug_dir);
+    for (const auto& mode : modes) runMode(config, mode, seq, first, count, debug_dir, verbose);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dyn_bench: %s\n", e.what());
     return 1;

@@ -10,6 +10,11 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.ransac_confidence", &c.ransac_confidence, 0.5, 0.999999);
   schema.addDouble("dynamic.homography_inlier_ratio", &c.homography_inlier_ratio, 0.0, 10.0);
 
+  schema.addString("dynamic.geometric_check", &c.geometric_check, {"rigid", "epipolar"});
+  schema.addDouble("dynamic.reprojection_threshold_px", &c.reprojection_threshold_px, 0.01, 100.0);
+  schema.addDouble("dynamic.rigid_epipolar_threshold_px", &c.rigid_epipolar_threshold_px, 0.01,
+                   100.0);
+  schema.addInt("dynamic.bucket_px", &c.bucket_px, 1, 1000);
   schema.addString("dynamic.detector", &c.detector,
                    {"yolo_darknet", "yolov5_onnx", "yolov8_onnx", "nanodet_onnx", "none"});
   schema.addString("dynamic.model_cfg", &c.model_cfg);
@@ -32,7 +37,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.moving_ratio", &c.moving_ratio, 0.0, 1.0);
   schema.addInt("dynamic.min_object_points", &c.min_object_points, 1, 100000);
   schema.addInt("dynamic.min_dynamic_points", &c.min_dynamic_points, 1, 100000);
-  schema.addInt("dynamic.hold_frames", &c.hold_frames, 0, 1000);
+  schema.addDouble("dynamic.evidence_smoothing", &c.evidence_smoothing, 0.0, 0.99);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);
   schema.addDouble("dynamic.cluster_radius_px", &c.cluster_radius_px, 1.0, 1000.0);

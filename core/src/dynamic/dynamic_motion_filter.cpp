@@ -1,5 +1,6 @@
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -140,9 +141,10 @@ DetectorOptions detectorOptions(const DynamicConfig& c) {
   return o;
 }
 
-DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config,
-                                         const PinholeCamera& /*camera*/, TimingRecorder* timing)
+DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config, const PinholeCamera& camera,
+                                         TimingRecorder* timing)
     : config_(config),
+      K_(camera.fx, camera.fy, camera.cx, camera.cy),
       mode_(parseMode(config.mode)),
       classes_(config),
       fusion_(config, classes_),
@@ -173,23 +175,56 @@ std::vector<Detection> DynamicMotionFilter::waitDetections(const RgbdFrame* fram
   return ok ? dets : worker_->runNow(frame->bgr);  // beginFrame() was not called for this frame
 }
 
+EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
+                                                  const std::vector<Detection>& dets) {
+  EpipolarOptions eo;
+  eo.threshold_px = config_.epipolar_threshold_px;
+  eo.min_matches = config_.min_matches;
+  eo.min_parallax_px = config_.min_parallax_px;
+  eo.confidence = config_.ransac_confidence;
+  eo.homography_inlier_ratio = config_.homography_inlier_ratio;
+  eo.reprojection_threshold_px = config_.reprojection_threshold_px;
+  eo.rigid_epipolar_threshold_px = config_.rigid_epipolar_threshold_px;
+  eo.bucket_px = config_.bucket_px;
+  if (config_.geometric_check == "epipolar" || depth.empty()) {
+    return checkEpipolar(m.prev_px, m.cur_px, eo);
+  }
+  // Matches on last frame's moving regions and inside high-dynamic boxes do not vote for the
+  // camera motion (a large textured mover can otherwise out-vote a nearly planar background),
+  // unless too few others remain.
+  const std::size_t n = m.cur_px.size();
+  std::vector<std::uint8_t> outside_mask(n, 1), outside_all(n, 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    outside_mask[i] = inMask(prev_mask_, m.cur_px[i]) ? 0 : 1;
+    outside_all[i] = outside_mask[i];
+    for (const auto& d : dets) {
+      if (classes_.isHighDynamic(d.class_id) && d.box.contains(m.cur_px[i])) outside_all[i] = 0;
+    }
+  }
+  const auto enough = [&](const std::vector<std::uint8_t>& v) {
+    const auto c = std::count(v.begin(), v.end(), 1);
+    return c >= config_.min_matches && 4 * c >= static_cast<long>(n);
+  };
+  const std::vector<std::uint8_t> none;
+  const auto& may_fit =
+      enough(outside_all) ? outside_all : (enough(outside_mask) ? outside_mask : none);
+  return checkRigidMotion(m.prev_px, m.cur_px, depth, K_, may_fit, eo, &motion_);
+}
+
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   static const FeatureMatches kNoMatches;
   const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
+  auto dets = waitDetections(input.frame);
+  const cv::Mat frame_depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
+
   auto start = Clock::now();
   EpipolarResult epi;
-  if (mode_ != FusionMode::kDetector) {
-    EpipolarOptions eo{config_.epipolar_threshold_px, config_.min_matches, config_.min_parallax_px,
-                       config_.ransac_confidence, config_.homography_inlier_ratio};
-    epi = checkEpipolar(m.prev_px, m.cur_px, eo);
-  }
+  if (mode_ != FusionMode::kDetector) epi = checkGeometry(m, frame_depth, dets);
   epi.is_dynamic.resize(m.cur_px.size(), 0);
   record("epipolar", msSince(start));
 
-  auto dets = waitDetections(input.frame);
-
   start = Clock::now();
-  cv::Mat depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
+  cv::Mat depth = frame_depth;
   if (depth.empty()) {
     const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
     depth = cv::Mat::zeros(size, CV_32FC1);
@@ -201,16 +236,18 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     out.match_is_dynamic[i] = (epi.is_dynamic[i] || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
   }
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
+  prev_mask_ = fused.mask;
   record("fusion", msSince(start));
 
-  diagnostics_ = MotionDiagnostics{m,
-                                   epi.is_dynamic,
-                                   out.match_is_dynamic,
-                                   epi.model,
-                                   std::move(dets),
-                                   std::move(fused.objects),
-                                   fused.clusters,
-                                   fused.mask};
+  diagnostics_.matches = m;
+  diagnostics_.epipolar_dynamic = epi.is_dynamic;
+  diagnostics_.residual_px = epi.residual_px;
+  diagnostics_.match_is_dynamic = out.match_is_dynamic;
+  diagnostics_.model = epi.model;
+  diagnostics_.detections = std::move(dets);
+  diagnostics_.objects = std::move(fused.objects);
+  diagnostics_.clusters = fused.clusters;
+  diagnostics_.mask = fused.mask;
   return out;
 }
 

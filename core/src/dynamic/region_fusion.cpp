@@ -113,21 +113,27 @@ RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classe
     : config_(config), classes_(classes) {}
 
 void RegionFusion::decideObject(ObjectDecision& d, std::vector<Track>& next) {
-  d.moving_now = d.points >= config_.min_object_points &&
-                 d.dynamic_points >= config_.min_dynamic_points &&
-                 d.weight * d.dynamic_points / std::max(1, d.points) >= config_.moving_ratio;
-  int hold = 0;
+  // Evidence: class prior x share of dynamic points on the object's own pixels.
+  const bool observed = d.points >= config_.min_object_points;
+  const double evidence = observed ? d.weight * d.dynamic_points / d.points : 0.0;
+  d.moving_now = observed && d.dynamic_points >= config_.min_dynamic_points &&
+                 evidence >= config_.moving_ratio;
+  const Track* prev = nullptr;
   float best_iou = 0.3f;
   for (const auto& t : tracks_) {
     const float o = iou(t.box, d.detection.box);
-    if (t.class_id == d.detection.class_id && o > best_iou) {
-      best_iou = o;
-      hold = t.hold;
-    }
+    if (t.class_id == d.detection.class_id && o > best_iou) best_iou = o, prev = &t;
   }
-  hold = d.moving_now ? config_.hold_frames : std::max(0, hold - 1);
-  d.moving = d.moving_now || hold > 0;
-  next.push_back(Track{d.detection.box, d.detection.class_id, hold});
+  // Temporal hysteresis: the evidence is smoothed over frames; an object turns moving when the
+  // smoothed evidence reaches moving_ratio (with enough dynamic points now) and stays moving
+  // until it falls below half of it. Unobserved frames keep the previous state.
+  const double a = config_.evidence_smoothing;
+  double score = evidence;
+  if (prev != nullptr) score = observed ? a * prev->score + (1.0 - a) * evidence : prev->score;
+  const bool was_moving = prev != nullptr && prev->moving;
+  d.moving = was_moving ? score >= 0.5 * config_.moving_ratio
+                        : (d.moving_now && score >= config_.moving_ratio);
+  next.push_back(Track{d.detection.box, d.detection.class_id, score, d.moving});
 }
 
 FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,

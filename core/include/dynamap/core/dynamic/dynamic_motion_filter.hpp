@@ -20,6 +20,7 @@ namespace dynamap {
 struct MotionDiagnostics {
   FeatureMatches matches;
   std::vector<std::uint8_t> epipolar_dynamic;  ///< geometric check per match
+  std::vector<float> residual_px;              ///< its residual per match
   std::vector<std::uint8_t> match_is_dynamic;  ///< final flag per match
   EpipolarModel model = EpipolarModel::kNone;
   std::vector<Detection> detections;  ///< detector output after NMS
@@ -54,8 +55,11 @@ class DynamicMotionFilter : public MotionFilter {
   class Worker;
   void record(const std::string& stage, double ms);
   std::vector<Detection> waitDetections(const RgbdFrame* frame);
+  EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
+                               const std::vector<Detection>& dets);
 
   DynamicConfig config_;
+  cv::Vec4d K_;  ///< fx, fy, cx, cy
   FusionMode mode_;
   ClassTable classes_;
   RegionFusion fusion_;
@@ -63,6 +67,8 @@ class DynamicMotionFilter : public MotionFilter {
   TimingRecorder* timing_;
   TimingRecorder own_timing_;
   MotionDiagnostics diagnostics_;
+  RigidMotion motion_;  ///< last frame-to-frame camera motion (diagnostics)
+  cv::Mat prev_mask_;   ///< last frame's mask: its matches do not vote for the camera motion
 };
 
 /// nullptr for mode "off"; modes geometry | detector | both. Throws like the constructor.

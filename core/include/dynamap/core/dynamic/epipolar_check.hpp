@@ -13,12 +13,16 @@ struct EpipolarOptions {
   double min_parallax_px = 0.3;
   double confidence = 0.999;
   double homography_inlier_ratio = 0.95;
+  double reprojection_threshold_px = 4.0;    ///< rigid check (with depth): reprojection error
+  double rigid_epipolar_threshold_px = 2.5;  ///< rigid check, matches without depth
+  int bucket_px = 40;                        ///< model fit uses at most 2 matches per cell
 };
 
 enum class EpipolarModel : std::uint8_t {
   kNone,         ///< degenerate (few matches / no motion): nothing flagged
   kFundamental,  ///< symmetric epipolar distance to a refitted F
   kHomography,   ///< low parallax: homography transfer error (F ill-conditioned)
+  kRigid,        ///< depth available: PnP pose, reprojection error (+ epipolar w/o depth)
 };
 
 struct EpipolarResult {
@@ -39,5 +43,29 @@ double symmetricEpipolarDistance(const cv::Matx33d& F, const cv::Point2f& p1,
 EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
                              const std::vector<cv::Point2f>& cur_px,
                              const EpipolarOptions& options);
+
+/// Frame-to-frame camera motion as found by checkRigidMotion(): a current-frame point X maps
+/// to the previous frame as R(rvec) X + tvec.
+struct RigidMotion {
+  cv::Vec3d rvec, tvec;
+  bool valid = false;
+};
+
+/// The same check made well-conditioned with the current depth (RGB-D): the static camera
+/// motion is a PnP-RANSAC pose from the current frame's 3-D points to the previous pixels,
+/// fitted on a spatially bucketed subset of the matches with `may_fit` set (so a large, richly
+/// textured moving person cannot out-vote the background), refined on its inliers.
+/// A match with depth is dynamic if its reprojection error exceeds reprojection_threshold_px;
+/// one without depth if its symmetric epipolar distance to the pose's F exceeds
+/// rigid_epipolar_threshold_px.
+/// Points beyond the depth range (no reading around them, away from the border) join the fit
+/// as far points: they pin the rotation that a near, nearly planar static layer leaves
+/// ambiguous with translation (which lets a large mover's motion fit the static layer to ~1 px).
+/// Falls back to checkEpipolar() when too few matches have depth.
+/// `K` = (fx, fy, cx, cy); `may_fit` empty = all; `estimated` (may be null) gets the motion.
+EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
+                                const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
+                                const cv::Vec4d& K, const std::vector<std::uint8_t>& may_fit,
+                                const EpipolarOptions& options, RigidMotion* estimated = nullptr);
 
 }  // namespace dynamap

@@ -54,7 +54,8 @@ class RegionFusion {
   struct Track {
     cv::Rect2f box;
     int class_id = -1;
-    int hold = 0;  ///< frames the object stays moving without new evidence
+    double score = 0.0;  ///< smoothed motion evidence
+    bool moving = false;
   };
   void decideObject(ObjectDecision& d, std::vector<Track>& next);
   int growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,

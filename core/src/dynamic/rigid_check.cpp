@@ -1,0 +1,150 @@
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <opencv2/calib3d.hpp>
+
+#include "dynamap/core/dynamic/epipolar_check.hpp"
+
+namespace dynamap {
+
+namespace {
+
+constexpr int kMinFitPoints = 12;
+constexpr float kFarDepthM = 12.f;
+
+/// Depth at `p` if valid and not on a depth edge (5x5 range < 5 % of the depth), else 0.
+float stableDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
+  const int u = cvRound(p.x), v = cvRound(p.y);
+  if (u < 2 || v < 2 || u >= depth_m.cols - 2 || v >= depth_m.rows - 2) return 0.f;
+  const float z = depth_m.at<float>(v, u);
+  if (!(z > 0.1f && z < 8.f)) return 0.f;
+  float lo = z, hi = z;
+  for (int dv = -2; dv <= 2; ++dv) {
+    const float* row = depth_m.ptr<float>(v + dv);
+    for (int du = -2; du <= 2; ++du) {
+      const float d = row[u + du];
+      if (d <= 0.f) return 0.f;
+      lo = std::min(lo, d), hi = std::max(hi, d);
+    }
+  }
+  return hi - lo < 0.05f * z ? z : 0.f;
+}
+
+/// True if the sensor measured nothing around `p` (away from the image border, where depth
+/// sensors never measure): a surface beyond the depth range.
+bool beyondRange(const cv::Mat& depth_m, const cv::Point2f& p) {
+  const int u = cvRound(p.x), v = cvRound(p.y);
+  if (u < 32 || v < 16 || u >= depth_m.cols - 32 || v >= depth_m.rows - 16) return false;
+  for (int dv = -3; dv <= 3; ++dv) {
+    const float* row = depth_m.ptr<float>(v + dv);
+    for (int du = -3; du <= 3; ++du) {
+      if (row[u + du] > 0.f) return false;
+    }
+  }
+  return true;
+}
+
+bool medianFlowBelow(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b,
+                     double px) {
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = cv::norm(a[i] - b[i]);
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2] < px;
+}
+
+struct PoseFit {
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;  ///< indices into the fit arrays
+  bool ok = false;
+};
+
+/// PnP-RANSAC (EPnP samples) + Levenberg-Marquardt refinement on the inliers.
+PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
+                const cv::Matx33d& K, double threshold_px, double confidence) {
+  PoseFit f;
+  if (static_cast<int>(X.size()) < kMinFitPoints) return f;
+  f.ok = cv::solvePnPRansac(X, p, K, cv::noArray(), f.rvec, f.tvec, false, 300,
+                            static_cast<float>(threshold_px), confidence, f.inliers,
+                            cv::SOLVEPNP_EPNP) &&
+         static_cast<int>(f.inliers.size()) >= kMinFitPoints / 2;
+  if (!f.ok) return f;
+  std::vector<cv::Point3f> ix;
+  std::vector<cv::Point2f> ip;
+  for (int k : f.inliers) ix.push_back(X[k]), ip.push_back(p[k]);
+  cv::solvePnPRefineLM(ix, ip, K, cv::noArray(), f.rvec, f.tvec);
+  return f;
+}
+
+}  // namespace
+
+EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
+                                const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
+                                const cv::Vec4d& K, const std::vector<std::uint8_t>& may_fit,
+                                const EpipolarOptions& o, RigidMotion* estimated) {
+  if (estimated != nullptr) *estimated = RigidMotion{};
+  const std::size_t n = std::min(prev_px.size(), cur_px.size());
+  EpipolarResult r;
+  r.residual_px.assign(n, 0.f);
+  r.is_dynamic.assign(n, 0);
+  if (static_cast<int>(n) < std::max(o.min_matches, 8) || depth_m.empty()) {
+    return depth_m.empty() ? checkEpipolar(prev_px, cur_px, o) : r;
+  }
+  if (medianFlowBelow(prev_px, cur_px, o.min_parallax_px)) return r;
+
+  std::vector<cv::Point3f> X(n);
+  std::vector<float> z(n);
+  std::vector<int> fit;  // bucketed subset with depth
+  std::map<std::pair<int, int>, int> cells;
+  const int bucket = std::max(1, o.bucket_px);
+  for (std::size_t i = 0; i < n; ++i) {
+    z[i] = stableDepth(depth_m, cur_px[i]);
+    // Points beyond the depth range join the fit as far points (they pin the rotation, which a
+    // near, nearly planar static layer leaves ambiguous with translation); their residual
+    // is the epipolar distance.
+    const float z_fit = z[i] > 0.f ? z[i] : (beyondRange(depth_m, cur_px[i]) ? kFarDepthM : 0.f);
+    X[i] = cv::Point3f(static_cast<float>((cur_px[i].x - K[2]) * z_fit / K[0]),
+                       static_cast<float>((cur_px[i].y - K[3]) * z_fit / K[1]), z_fit);
+    if (z_fit <= 0.f || (!may_fit.empty() && (i >= may_fit.size() || !may_fit[i]))) continue;
+    auto& c = cells[{cvFloor(cur_px[i].x / bucket), cvFloor(cur_px[i].y / bucket)}];
+    if (c++ < 2) fit.push_back(static_cast<int>(i));
+  }
+  if (static_cast<int>(fit.size()) < kMinFitPoints) return checkEpipolar(prev_px, cur_px, o);
+
+  std::vector<cv::Point3f> fx;
+  std::vector<cv::Point2f> fp;
+  for (int i : fit) fx.push_back(X[i]), fp.push_back(prev_px[i]);
+  const cv::Matx33d Km(K[0], 0, K[2], 0, K[1], K[3], 0, 0, 1);
+  const double fit_thr = 0.5 * o.reprojection_threshold_px;
+  PoseFit best = fitPose(fx, fp, Km, fit_thr, o.confidence);
+  if (!best.ok) return checkEpipolar(prev_px, cur_px, o);
+  const cv::Mat& rvec = best.rvec;
+  const cv::Mat& tvec = best.tvec;
+  if (estimated != nullptr) *estimated = RigidMotion{cv::Vec3d(rvec), cv::Vec3d(tvec), true};
+
+  // F of the pose (previous -> current): X_cur = R^T (X_prev - t).
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  const cv::Vec3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  const cv::Matx33d Rc = R.t();
+  const cv::Vec3d tc = -(Rc * t);
+  const cv::Matx33d tx(0, -tc[2], tc[1], tc[2], 0, -tc[0], -tc[1], tc[0], 0);
+  const cv::Matx33d Kinv = Km.inv();
+  const cv::Matx33d F = Kinv.t() * tx * Rc * Kinv;
+  r.model = EpipolarModel::kRigid;
+  r.F = cv::Mat(F).clone();
+  std::vector<cv::Point2f> proj;
+  cv::projectPoints(X, rvec, tvec, Km, cv::noArray(), proj);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (z[i] > 0.f) {
+      r.residual_px[i] = static_cast<float>(cv::norm(proj[i] - prev_px[i]));
+      r.is_dynamic[i] = r.residual_px[i] > o.reprojection_threshold_px;
+    } else {
+      r.residual_px[i] = static_cast<float>(symmetricEpipolarDistance(F, prev_px[i], cur_px[i]));
+      r.is_dynamic[i] = r.residual_px[i] > o.rigid_epipolar_threshold_px;
+    }
+  }
+  return r;
+}
+
+}  // namespace dynamap
