@@ -1,0 +1,151 @@
+// End-to-end tests of the `dynamap` program: outputs of a run, and bad input / faults that must
+// give one clear error or a partial-but-complete set of outputs.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "app_config.hpp"
+#include "cli_test_util.hpp"
+#include "map_metrics.hpp"
+#include "test_paths.hpp"
+#include "trajectory_io.hpp"
+
+namespace dynamap {
+namespace {
+
+namespace fs = std::filesystem;
+using test::runDynamap;
+
+// Fast settings: no detector, raw points.
+const std::vector<std::string> kFast = {"--set", "dynamic.mode=off", "--set",
+                                        "mapping.backend=points", "--quiet"};
+
+std::vector<std::string> runArgs(const std::string& seq, const std::string& out,
+                                 std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"run", "--sequence", seq, "--out", out};
+  args.insert(args.end(), kFast.begin(), kFast.end());
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
+TEST(RunCommand, WritesEveryOutputOnARealSequence) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const std::string seq = test::makeTeddySubset("cli_teddy40", 40);
+  const fs::path out = test::freshTempDir("cli_out40");
+  const auto r = runDynamap(runArgs(seq, out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  // 40 colour frames -> a pose for each (frames without associated depth are tracked too).
+  EXPECT_EQ(test::countDataLines((out / "trajectory.txt").string()), 40u);
+  EXPECT_GE(test::countDataLines((out / "keyframes.txt").string()), 1u);
+  const std::string timings = test::readFile((out / "timings.json").string());
+  EXPECT_NE(timings.find("\"frames_per_s\""), std::string::npos);
+  EXPECT_NE(timings.find("\"tracking_median_ms\""), std::string::npos);
+  const std::string metrics = test::readFile((out / "metrics.json").string());
+  EXPECT_NE(metrics.find("\"ate\""), std::string::npos);
+  EXPECT_NE(metrics.find("\"rpe\""), std::string::npos);
+  EXPECT_NE(test::readFile((out / "run.json").string()).find("\"complete\""), std::string::npos);
+  EXPECT_TRUE(fs::file_size(out / "trajectory.png") > 10000);
+  EXPECT_GT(readPlyVertices((out / "map" / "cloud.ply").string()).size(), 10000u);
+  // The effective config loads back.
+  EXPECT_NO_THROW(loadAppConfig((out / "config.yaml").string(), {}));
+  // The trajectory in metrics.json agrees with `dynamap evaluate` on the written file.
+  const auto eval = runDynamap({"evaluate", "--gt", seq + "/groundtruth.txt", "--est",
+                                (out / "trajectory.txt").string(), "--json"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  const auto rmse_at = [](const std::string& json) {
+    const auto p = json.find("\"rmse_m\":");
+    return std::stod(json.substr(p + 9));
+  };
+  EXPECT_NEAR(rmse_at(eval.out), rmse_at(metrics), 1e-9);
+}
+
+TEST(RunCommand, UnknownConfigKeyIsOneClearError) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const std::string seq = test::makeTeddySubset("cli_badkey", 5);
+  const auto r = runDynamap(runArgs(seq, test::freshTempDir("cli_badkey_out").string(),
+                                    {"--set", "tracking.no_such_key=3"}));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("tracking.no_such_key"), std::string::npos) << r.err;
+}
+
+TEST(RunCommand, BadConfigFileNamesFileAndLine) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const fs::path dir = test::freshTempDir("cli_badcfg");
+  std::ofstream(dir / "bad.yaml") << "camera:\n  preset: freiburg3\n  focal: 500\n";
+  const std::string seq = test::makeTeddySubset("cli_badcfg_seq", 5);
+  const auto r = runDynamap({"run", "--config", (dir / "bad.yaml").string(), "--sequence", seq,
+                             "--out", (dir / "out").string()});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("bad.yaml:3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("camera.focal"), std::string::npos) << r.err;
+}
+
+TEST(RunCommand, UnknownBackendListsThePluginsFound) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const std::string seq = test::makeTeddySubset("cli_badbackend", 5);
+  const auto r = runDynamap(runArgs(seq, test::freshTempDir("cli_badbackend_out").string(),
+                                    {"--set", "mapping.backend=nope"}));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("nope"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("points"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("vdb_tsdf"), std::string::npos) << r.err;
+}
+
+TEST(RunCommand, MissingSequenceExplainsWhereToDownload) {
+  const auto r = runDynamap({"run", "--sequence", "/nonexistent/rgbd_dataset_freiburg3_walking_xyz",
+                             "--out", test::freshTempDir("cli_missing").string()});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("not found"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rgbd-dataset/download"), std::string::npos) << r.err;
+}
+
+TEST(RunCommand, CorruptFrameMidSequenceIsSkippedAndCounted) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const fs::path seq = test::makeTeddySubset("cli_corrupt", 30);
+  // Replace the 15th colour image by garbage.
+  std::ifstream list(seq / "rgb.txt");
+  std::string line;
+  int n = 0;
+  std::string victim;
+  while (std::getline(list, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (++n == 15) victim = line.substr(line.find(' ') + 1);
+  }
+  fs::remove(seq / victim);
+  std::ofstream(seq / victim) << "this is not a png";
+  const fs::path out = test::freshTempDir("cli_corrupt_out");
+  const auto r = runDynamap(runArgs(seq.string(), out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string run_json = test::readFile((out / "run.json").string());
+  EXPECT_NE(run_json.find("\"bad_frames\": 1"), std::string::npos) << run_json;
+  EXPECT_EQ(test::countDataLines((out / "trajectory.txt").string()), 29u);
+  EXPECT_NE(r.err.find(victim), std::string::npos) << r.err;  // the warning names the file
+}
+
+TEST(RunCommand, InterruptWritesTrajectoryAndMapSoFar) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const std::string seq = (test::sharedData() / "tum" / "rgbd_dataset_freiburg3_teddy").string();
+  const fs::path out = test::freshTempDir("cli_sigint");
+  const auto r = runDynamap(runArgs(seq, out.string()), /*interrupt_after_s=*/4.0);
+  EXPECT_EQ(r.exit_code, 130) << r.err;
+  const std::string run_json = test::readFile((out / "run.json").string());
+  EXPECT_NE(run_json.find("\"interrupted\""), std::string::npos) << run_json;
+  const std::size_t poses = test::countDataLines((out / "trajectory.txt").string());
+  EXPECT_GT(poses, 0u);
+  EXPECT_LT(poses, 200u);
+  EXPECT_GT(readPlyVertices((out / "map" / "cloud.ply").string()).size(), 1000u);
+}
+
+TEST(RunCommand, UnwritableOutputFolderIsAClearError) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const fs::path dir = test::freshTempDir("cli_unwritable");
+  std::ofstream(dir / "a_file") << "x";  // a file where a folder is needed
+  const std::string seq = test::makeTeddySubset("cli_unwritable_seq", 5);
+  const auto r = runDynamap(runArgs(seq, (dir / "a_file" / "out").string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("a_file"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dynamap
