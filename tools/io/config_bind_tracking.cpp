@@ -7,6 +7,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.orb_levels", &c.orb_levels, 1, 16);
   schema.addDouble("tracking.orb_scale_factor", &c.orb_scale_factor, 1.01, 2.0);
   schema.addInt("tracking.orb_fast_threshold", &c.orb_fast_threshold, 1, 100);
+  schema.addInt("tracking.orb_fast_threshold_min", &c.orb_fast_threshold_min, 0, 100);
   schema.addInt("tracking.grid_cell_px", &c.grid_cell_px, 4, 320);
   schema.addInt("tracking.min_tracked_features", &c.min_tracked_features, 10, 5000);
 

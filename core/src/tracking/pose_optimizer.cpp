@@ -19,7 +19,7 @@ RgbdResidual makeResidual(const PinholeCamera& camera, const TrackerConfig& conf
                                  ? 1.0 / depthSigma(config.depth_sigma_coeff, c.depth_m)
                                  : 0.0;
   return RgbdResidual(camera, c.px, config.use_depth_residual ? c.depth_m : 0.0,
-                      1.0 / config.pixel_sigma_px, inv_sigma_z);
+                      1.0 / (config.pixel_sigma_px * c.sigma_scale), inv_sigma_z);
 }
 
 }  // namespace
@@ -28,7 +28,8 @@ PoseOptimizer::PoseOptimizer(const PinholeCamera& camera, const TrackerConfig& c
     : camera_(camera), config_(config) {}
 
 bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
-                           std::vector<std::uint8_t>& inlier, bool use_guess) const {
+                           std::vector<std::uint8_t>& inlier, bool use_guess,
+                           int iterations) const {
   inlier.assign(corr.size(), 0);
   if (corr.size() < 6) return false;
   std::vector<cv::Point3f> object;
@@ -48,7 +49,7 @@ bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::I
   cv::eigen2cv(Eigen::Vector3d(T_C_W.translation()), tvec);
   std::vector<int> idx;
   const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, use_guess,
-                                     config_.pnp_ransac_iterations,
+                                     iterations > 0 ? iterations : config_.pnp_ransac_iterations,
                                      static_cast<float>(config_.pnp_reprojection_px), 0.99, idx,
                                      use_guess ? cv::SOLVEPNP_ITERATIVE : cv::SOLVEPNP_AP3P);
   if (!ok || static_cast<int>(idx.size()) < 4) return false;
@@ -60,8 +61,22 @@ bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::I
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Re;
   T.translation() = te;
+  // OpenCV refines the final model on its inliers, which can (rarely) jump to a wrong minimum:
+  // keep the result only if it still explains most of RANSAC's inliers.
+  const double th2 = config_.pnp_reprojection_px * config_.pnp_reprojection_px;
+  int count = 0;
+  for (std::size_t i = 0; i < corr.size(); ++i) {
+    const Eigen::Vector3d p_C = T * corr[i].p_W;
+    if (p_C.z() <= 0.0) continue;
+    if ((camera_.project(p_C) - corr[i].px).squaredNorm() > th2) continue;
+    inlier[i] = 1;
+    ++count;
+  }
+  if (2 * count < static_cast<int>(idx.size())) {
+    inlier.assign(corr.size(), 0);
+    return false;
+  }
   T_W_C = T.inverse();
-  for (int i : idx) inlier[static_cast<std::size_t>(i)] = 1;
   return true;
 }
 
@@ -113,7 +128,8 @@ PoseEstimate PoseOptimizer::estimate(const std::vector<PoseCorrespondence>& corr
   est.T_W_C = T_W_C_guess;
   {
     ScopedStageTimer timer(timings, "pnp");
-    if (!ransac(corr, est.T_W_C, est.inlier)) {
+    const bool rok = ransac(corr, est.T_W_C, est.inlier);
+    if (!rok) {
       // No RANSAC model: start the robust refinement from the prediction with every match.
       est.T_W_C = T_W_C_guess;
       est.inlier.assign(corr.size(), 1);

@@ -1,48 +1,134 @@
 #include "dynamap/core/tracking/relocalizer.hpp"
 
-#include <opencv2/features2d.hpp>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
 
 namespace dynamap {
+namespace {
+
+// Search radii around the landmarks' projections with the last known pose.
+constexpr double kGuidedRadiiPx[] = {60.0, 160.0};
+constexpr float kGuidedRatio = 0.9f;
+constexpr int kRelocRansacIterations = 1000;
+
+struct Candidates {
+  std::vector<std::uint64_t> ids;
+  cv::Mat descriptors;
+  std::vector<Eigen::Vector3d> points;
+};
+
+/// For each query: best train index (or -1) under the ratio test, among trains allowed by `near`.
+template <typename Near>
+std::vector<int> bestMatches(const cv::Mat& dist, int max_hamming, float ratio, Near near) {
+  std::vector<int> best(static_cast<std::size_t>(dist.rows), -1);
+  for (int q = 0; q < dist.rows; ++q) {
+    const int* row = dist.ptr<int>(q);
+    int b1 = std::numeric_limits<int>::max(), b2 = b1, arg = -1;
+    for (int t = 0; t < dist.cols; ++t) {
+      if (row[t] >= b2 || !near(q, t)) continue;
+      if (row[t] < b1) {
+        b2 = b1;
+        b1 = row[t];
+        arg = t;
+      } else {
+        b2 = row[t];
+      }
+    }
+    if (arg >= 0 && b1 <= max_hamming && static_cast<float>(b1) <= ratio * static_cast<float>(b2)) {
+      best[static_cast<std::size_t>(q)] = arg;
+    }
+  }
+  return best;
+}
+
+}  // namespace
 
 Relocalizer::Relocalizer(const TrackerConfig& config, const PoseOptimizer& optimizer)
     : config_(config), optimizer_(optimizer) {}
 
 RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const cv::Mat& depth_m,
-                                             const LocalMap& map) const {
-  RelocalizationResult result;
-  if (features.keypoints.size() < 6) return result;
-  std::vector<std::uint64_t> ids;
-  cv::Mat descriptors;
-  std::vector<Eigen::Vector3d> points;
-  map.relocCandidates(config_.reloc_keyframes, ids, descriptors, points);
-  if (ids.size() < 6) return result;
+                                             const LocalMap& map, const PinholeCamera& camera,
+                                             const Eigen::Isometry3d& T_W_C_hint) const {
+  if (features.keypoints.size() < 6) return {};
+  Candidates c;
+  map.relocCandidates(config_.reloc_keyframes, c.ids, c.descriptors, c.points);
+  if (c.ids.size() < 6) return {};
+  cv::Mat dist;
+  cv::batchDistance(features.descriptors, c.descriptors, dist, CV_32S, cv::noArray(),
+                    cv::NORM_HAMMING);
 
-  cv::BFMatcher matcher(cv::NORM_HAMMING);
-  std::vector<std::vector<cv::DMatch>> knn;
-  matcher.knnMatch(features.descriptors, descriptors, knn, 2);
+  // 1) Guided: landmarks projected with the last known pose, matched within a radius.
+  const Eigen::Isometry3d T_C_W = T_W_C_hint.inverse();
+  std::vector<Eigen::Vector2d> proj(c.points.size());
+  std::vector<char> visible(c.points.size(), 0);
+  for (std::size_t i = 0; i < c.points.size(); ++i) {
+    const Eigen::Vector3d p_C = T_C_W * c.points[i];
+    if (p_C.z() <= 0.1) continue;
+    proj[i] = camera.project(p_C);
+    visible[i] = 1;
+  }
+  for (const double radius_px : kGuidedRadiiPx) {
+    const double r2 = radius_px * radius_px;
+    const auto guided =
+        bestMatches(dist, config_.reloc_max_hamming, kGuidedRatio, [&](int q, int t) {
+          const auto ti = static_cast<std::size_t>(t);
+          if (!visible[ti]) return false;
+          const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(q)].pt;
+          return (proj[ti] - Eigen::Vector2d(p.x, p.y)).squaredNorm() < r2;
+        });
+    RelocalizationResult result = solve(features, dist, depth_m, c.ids, c.points, guided);
+    if (result.ok) return result;
+  }
+  // 2) Global: any landmark of the recent keyframes, ratio test and mutual nearest neighbours.
+  auto global = bestMatches(dist, config_.reloc_max_hamming,
+                            static_cast<float>(config_.reloc_ratio), [](int, int) { return true; });
+  for (std::size_t q = 0; q < global.size(); ++q) {
+    if (global[q] < 0) continue;
+    double min_val = 0.0;
+    cv::Point min_loc;
+    cv::minMaxLoc(dist.col(global[q]), &min_val, nullptr, &min_loc);
+    if (min_loc.y != static_cast<int>(q)) global[q] = -1;
+  }
+  return solve(features, dist, depth_m, c.ids, c.points, global);
+}
+
+RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::Mat& dist,
+                                        const cv::Mat& depth_m,
+                                        const std::vector<std::uint64_t>& ids,
+                                        const std::vector<Eigen::Vector3d>& points,
+                                        const std::vector<int>& match) const {
+  RelocalizationResult result;
   std::vector<PoseCorrespondence> corr;
-  std::vector<int> query_index, train_index;
-  std::vector<char> train_used(ids.size(), 0);
-  for (const auto& m : knn) {
-    if (m.empty() || m[0].distance > config_.reloc_max_hamming) continue;
-    if (m.size() > 1 && m[0].distance > config_.reloc_ratio * m[1].distance) continue;
-    if (train_used[static_cast<std::size_t>(m[0].trainIdx)]) continue;
-    train_used[static_cast<std::size_t>(m[0].trainIdx)] = 1;
-    const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(m[0].queryIdx)].pt;
-    PoseCorrespondence c;
-    c.p_W = points[static_cast<std::size_t>(m[0].trainIdx)];
-    c.px = Eigen::Vector2d(p.x, p.y);
-    c.depth_m = sampleDepth(depth_m, p.x, p.y, config_.depth_min_m, config_.depth_max_m);
-    corr.push_back(c);
-    query_index.push_back(m[0].queryIdx);
-    train_index.push_back(m[0].trainIdx);
+  std::vector<int> query_index;
+  // One query per landmark: the closest in descriptor distance (the same corner is often
+  // detected at several pyramid levels).
+  std::vector<int> owner(ids.size(), -1);
+  for (std::size_t q = 0; q < match.size(); ++q) {
+    if (match[q] < 0) continue;
+    int& o = owner[static_cast<std::size_t>(match[q])];
+    if (o < 0 || dist.at<int>(static_cast<int>(q), match[q]) < dist.at<int>(o, match[q])) {
+      o = static_cast<int>(q);
+    }
+  }
+  for (std::size_t q = 0; q < match.size(); ++q) {
+    if (match[q] < 0 || owner[static_cast<std::size_t>(match[q])] != static_cast<int>(q)) continue;
+    const cv::Point2f& p = features.keypoints[q].pt;
+    PoseCorrespondence pc;
+    pc.p_W = points[static_cast<std::size_t>(match[q])];
+    pc.px = Eigen::Vector2d(p.x, p.y);
+    pc.depth_m = sampleDepth(depth_m, p.x, p.y, config_.depth_min_m, config_.depth_max_m);
+    pc.sigma_scale = std::pow(config_.orb_scale_factor, features.keypoints[q].octave);
+    corr.push_back(pc);
+    query_index.push_back(static_cast<int>(q));
   }
   if (static_cast<int>(corr.size()) < config_.reloc_min_inliers) return result;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::vector<std::uint8_t> inlier;
-  if (!optimizer_.ransac(corr, T_W_C, inlier, false)) return result;
+  if (!optimizer_.ransac(corr, T_W_C, inlier, false, kRelocRansacIterations)) return result;
   const int count = optimizer_.refine(corr, T_W_C, inlier);
   if (count < config_.reloc_min_inliers) return result;
   result.ok = true;
@@ -50,8 +136,9 @@ RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const 
   result.inliers = count;
   for (std::size_t i = 0; i < corr.size(); ++i) {
     if (!inlier[i]) continue;
-    result.landmark_ids.push_back(ids[static_cast<std::size_t>(train_index[i])]);
-    result.px.push_back(features.keypoints[static_cast<std::size_t>(query_index[i])].pt);
+    const auto q = static_cast<std::size_t>(query_index[i]);
+    result.landmark_ids.push_back(ids[static_cast<std::size_t>(match[q])]);
+    result.px.push_back(features.keypoints[q].pt);
   }
   return result;
 }

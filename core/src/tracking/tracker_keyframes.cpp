@@ -57,8 +57,15 @@ bool Tracker::Impl::relocalize(const RgbdFrame& frame, const cv::Mat& gray,
                                const cv::Mat& dynamic_mask, Eigen::Isometry3d& T_W_C,
                                int& inliers) {
   tracks_.clear();
-  const OrbFeatures features = extractOrb(gray, dynamic_mask);
-  const RelocalizationResult reloc = relocalizer_.relocalize(features, frame.depth_m, map_);
+  OrbFeatures features;
+  {
+    ScopedStageTimer timer(timings_, "orb");
+    cv::Mat allowed;
+    if (!dynamic_mask.empty()) allowed = dynamic_mask != 255;
+    features = extractor_.extractAll(gray, allowed);
+  }
+  const RelocalizationResult reloc =
+      relocalizer_.relocalize(features, frame.depth_m, map_, camera_, T_W_last_);
   if (!reloc.ok) return false;
   for (std::size_t i = 0; i < reloc.landmark_ids.size(); ++i) {
     tracks_.push_back(FeatureTrack{reloc.landmark_ids[i], reloc.px[i], reloc.px[i]});

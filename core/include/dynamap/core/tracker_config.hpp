@@ -10,8 +10,9 @@ struct TrackerConfig {
   int orb_levels = 8;              ///< ORB scale-pyramid levels
   double orb_scale_factor = 1.2;   ///< ORB scale between levels
   int orb_fast_threshold = 12;     ///< FAST threshold of the ORB detector
+  int orb_fast_threshold_min = 5;  ///< FAST threshold filling cells ORB left empty (0 = off)
   int grid_cell_px = 32;           ///< spatial grid cell; the best keypoint per cell is kept
-  int min_tracked_features = 150;  ///< fewer tracked features -> new keyframe + re-detection
+  int min_tracked_features = 100;  ///< fewer tracked features -> new keyframe + re-detection
 
   // --- Lucas-Kanade frame-to-frame matching ---
   int lk_levels = 6;                ///< pyramid levels of Lucas-Kanade optical flow
@@ -24,7 +25,7 @@ struct TrackerConfig {
   double depth_min_m = 0.1;  ///< depth readings outside [min, max] are ignored
   double depth_max_m = 6.0;
   double landmark_depth_max_m = 4.5;  ///< new landmarks only from depth below this
-  double depth_sigma_coeff = 0.0025;  ///< depth std-dev model sigma_z = coeff * z^2 (metres)
+  double depth_sigma_coeff = 0.006;   ///< depth std-dev model sigma_z = coeff * z^2 (metres)
   double pixel_sigma_px = 1.0;        ///< feature position std-dev
 
   // --- pose estimation ---
@@ -52,7 +53,7 @@ struct TrackerConfig {
   int reloc_keyframes = 30;    ///< newest keyframes whose landmarks are matched
   int reloc_max_hamming = 64;  ///< ORB descriptor distance gate
   double reloc_ratio = 0.8;    ///< Lowe ratio test
-  int reloc_min_inliers = 25;  ///< inliers needed to accept a relocalization
+  int reloc_min_inliers = 20;  ///< inliers needed to accept a relocalization
 };
 
 }  // namespace dynamap

@@ -16,7 +16,8 @@ struct OrbFeatures {
 };
 
 /// ORB over a scale pyramid, spread evenly: the image is cut into square cells and only the
-/// strongest keypoint of each free cell is kept. Not thread-safe (cv::ORB keeps buffers).
+/// strongest keypoint of each free cell is kept; cells still empty get the strongest FAST corner
+/// found with a lower threshold (as ORB-SLAM does). Not thread-safe (cv::ORB keeps buffers).
 class GridOrbExtractor {
  public:
   explicit GridOrbExtractor(const TrackerConfig& config);
@@ -25,10 +26,16 @@ class GridOrbExtractor {
   /// `occupied` (already tracked features) get no new keypoint.
   OrbFeatures extract(const cv::Mat& gray, const cv::Mat& allowed,
                       const std::vector<cv::Point2f>& occupied) const;
+  /// Every ORB keypoint of the pyramid (no grid): for relocalization by descriptor matching.
+  OrbFeatures extractAll(const cv::Mat& gray, const cv::Mat& allowed) const;
 
  private:
+  void fillEmptyCells(const cv::Mat& gray, const cv::Mat& allowed, int cols, int rows,
+                      const std::vector<char>& taken, OrbFeatures& out) const;
+
   cv::Ptr<cv::ORB> orb_;
   int cell_px_;
+  int fill_threshold_;
 };
 
 }  // namespace dynamap

@@ -15,7 +15,8 @@ namespace dynamap {
 struct PoseCorrespondence {
   Eigen::Vector3d p_W;
   Eigen::Vector2d px;
-  double depth_m = 0.0;  ///< measured depth at px, 0 = none
+  double depth_m = 0.0;      ///< measured depth at px, 0 = none
+  double sigma_scale = 1.0;  ///< pixel std-dev multiplier (ORB octave scale)
 };
 
 struct PoseEstimate {
@@ -39,7 +40,8 @@ class PoseOptimizer {
   /// RANSAC only; fills inlier flags. Returns false when RANSAC found no model. With
   /// `use_guess`, T_W_C seeds iterative PnP samples; otherwise minimal AP3P samples.
   bool ransac(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
-              std::vector<std::uint8_t>& inlier, bool use_guess = true) const;
+              std::vector<std::uint8_t>& inlier, bool use_guess = true,
+              int iterations = 0) const;  ///< iterations 0 = config's
 
   /// Motion-only refinement over the flagged correspondences; re-classifies inliers with a
   /// chi-square test. Returns the inlier count.

@@ -23,13 +23,22 @@ struct RelocalizationResult {
 
 /// Recovers the pose of a frame from ORB descriptor matches (brute-force Hamming, ratio test)
 /// against the landmarks of the newest keyframes, PnP-RANSAC without a prior, then refinement.
+/// Matches are first searched near the landmarks' projections with the last known pose, then,
+/// if that fails, among all candidates.
 class Relocalizer {
  public:
   Relocalizer(const TrackerConfig& config, const PoseOptimizer& optimizer);
   RelocalizationResult relocalize(const OrbFeatures& features, const cv::Mat& depth_m,
-                                  const LocalMap& map) const;
+                                  const LocalMap& map, const PinholeCamera& camera,
+                                  const Eigen::Isometry3d& T_W_C_hint) const;
 
  private:
+  /// match[q] = candidate index of query q or -1.
+  RelocalizationResult solve(const OrbFeatures& features, const cv::Mat& dist,
+                             const cv::Mat& depth_m, const std::vector<std::uint64_t>& ids,
+                             const std::vector<Eigen::Vector3d>& points,
+                             const std::vector<int>& match) const;
+
   TrackerConfig config_;
   const PoseOptimizer& optimizer_;
 };
