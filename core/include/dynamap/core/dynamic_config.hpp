@@ -23,7 +23,7 @@ struct DynamicConfig {
   double ransac_confidence = 0.999;
   /// Homography explains >= this share of the F inliers: low parallax / pure rotation; the
   /// homography transfer error is used instead of the ill-conditioned epipolar distance.
-  double homography_inlier_ratio = 0.95;
+  double homography_inlier_ratio = 0.85;
   /// rigid: PnP with the current depth (reprojection error; epipolar distance to the pose's F
   /// for matches without depth); epipolar: fundamental matrix only (no depth).
   std::string geometric_check = "rigid";

@@ -12,7 +12,7 @@ struct EpipolarOptions {
   int min_matches = 30;
   double min_parallax_px = 0.3;
   double confidence = 0.999;
-  double homography_inlier_ratio = 0.95;
+  double homography_inlier_ratio = 0.85;
   double reprojection_threshold_px = 4.0;    ///< rigid check (with depth): reprojection error
   double rigid_epipolar_threshold_px = 2.5;  ///< rigid check, matches without depth
   int bucket_px = 40;                        ///< model fit uses at most 2 matches per cell
