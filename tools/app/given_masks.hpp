@@ -24,6 +24,8 @@ class GivenMaskFilter : public MotionFilter {
   void setNextRgbPath(const std::string& rgb_path) { next_rgb_path_ = rgb_path; }
   void beginFrame(const RgbdFrame& frame) override;
   MotionFilterOutput filter(const MotionFilterInput& input) override;
+  /// The mask read by the last beginFrame() (empty when the file is absent).
+  const cv::Mat& currentMask() const { return mask_; }
 
  private:
   std::string masks_dir_;

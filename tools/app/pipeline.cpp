@@ -159,7 +159,7 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
     if (s.given_masks) {
       s.given_masks->setNextRgbPath(entry.rgb_path);
       s.given_masks->beginFrame(frame);
-      kf->dynamic_mask = s.given_masks->filter({&frame, nullptr, nullptr, nullptr}).dynamic_mask;
+      kf->dynamic_mask = s.given_masks->currentMask();
     }
     result.trajectory.push_back({frame.timestamp_s, *pose});
     result.frame_status.push_back("given");
