@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "dynamap/core/camera.hpp"
@@ -151,25 +152,28 @@ class SyntheticScene {
     }
     const double n_dot_o = n.dot(o);
     const int tw = r.texture.cols, th = r.texture.rows;
-    for (int y = y0; y <= y1; ++y) {
-      const double dy = (y - camera_.cy) / camera_.fy;
-      auto* bgr = f.bgr.ptr<cv::Vec3b>(y);
-      auto* depth = f.depth_m.ptr<float>(y);
-      auto* mask = f.mask.ptr<std::uint8_t>(y);
-      for (int x = x0; x <= x1; ++x) {
-        const Eigen::Vector3d d((x - camera_.cx) / camera_.fx, dy, 1.0);
-        const double denom = n.dot(d);
-        if (std::abs(denom) < 1e-12) continue;
-        const double z = n_dot_o / denom;
-        if (z < 0.05 || (depth[x] > 0.f && z >= depth[x])) continue;
-        const Eigen::Vector3d p = z * d - o;
-        const double a = p.dot(eu) * inv_uu, b = p.dot(ev) * inv_vv;
-        if (a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0) continue;
-        depth[x] = static_cast<float>(z);
-        bgr[x] = sample(r.texture, a * (tw - 1), b * (th - 1));
-        mask[x] = r.moving >= 0 ? 255 : 0;
+    // Rows are independent: render them in parallel.
+    cv::parallel_for_(cv::Range(y0, y1 + 1), [&](const cv::Range& rows) {
+      for (int y = rows.start; y < rows.end; ++y) {
+        const double dy = (y - camera_.cy) / camera_.fy;
+        auto* bgr = f.bgr.ptr<cv::Vec3b>(y);
+        auto* depth = f.depth_m.ptr<float>(y);
+        auto* mask = f.mask.ptr<std::uint8_t>(y);
+        for (int x = x0; x <= x1; ++x) {
+          const Eigen::Vector3d d((x - camera_.cx) / camera_.fx, dy, 1.0);
+          const double denom = n.dot(d);
+          if (std::abs(denom) < 1e-12) continue;
+          const double z = n_dot_o / denom;
+          if (z < 0.05 || (depth[x] > 0.f && z >= depth[x])) continue;
+          const Eigen::Vector3d p = z * d - o;
+          const double a = p.dot(eu) * inv_uu, b = p.dot(ev) * inv_vv;
+          if (a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0) continue;
+          depth[x] = static_cast<float>(z);
+          bgr[x] = sample(r.texture, a * (tw - 1), b * (th - 1));
+          mask[x] = r.moving >= 0 ? 255 : 0;
+        }
       }
-    }
+    });
   }
 
   static cv::Vec3b sample(const cv::Mat& tex, double u, double v) {
