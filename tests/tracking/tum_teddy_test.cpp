@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <time.h>
+
 #include <algorithm>
 #include <iostream>
 #include <map>
@@ -49,7 +51,14 @@ const std::vector<RgbdFrame>& teddyFrames() {
   return frames;
 }
 
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 struct TeddyRun {
+  std::vector<double> cpu_ms;  ///< CPU time of each track() call on the calling thread
   double ate_m = 1e9;
   std::size_t gt_matched = 0;
   std::vector<FrameStatus> statuses;
@@ -62,7 +71,9 @@ TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
   const auto& frames = teddyFrames();
   const auto gt = test::readTumGroundTruth((teddyDir() / "groundtruth.txt").string());
   Tracker tracker(cameraPreset("freiburg3"), TrackerConfig{}, timings);
+  TeddyRun run;
   for (const auto& f : frames) {
+    const double cpu_start = threadCpuMs();
     const int i = static_cast<int>(f.index);
     if (i >= blank_first && i < blank_first + blank_count) {
       RgbdFrame blank = f;
@@ -72,9 +83,9 @@ TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
     } else {
       tracker.track(f);
     }
+    run.cpu_ms.push_back(threadCpuMs() - cpu_start);
   }
   tracker.finish();
-  TeddyRun run;
   run.statuses = tracker.frameStatuses();
   run.stats = tracker.stats();
   const auto traj = tracker.finalTrajectory();
@@ -90,10 +101,10 @@ TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
   return run;
 }
 
-// Measured in Release on the 2-core machine (BA on its own thread, other builds running):
-// ATE RMSE 1.3-1.9 cm over repeated runs (BA timing makes runs slightly non-deterministic),
-// all 193 frames posed, median "tracking" 7-10 ms. The target is 2 cm; the assertion keeps a
-// margin for machine differences.
+// Measured in Release on the 2-core machine (BA on its own thread, load average ~10 from other
+// builds): ATE RMSE 0.8-1.1 cm over repeated runs (BA timing makes runs slightly
+// non-deterministic), all 193 frames posed, median "tracking" 13-15 ms wall clock, ~5 ms CPU
+// of the calling thread. The target is 2 cm; the 3 cm assertion keeps a margin.
 TEST(TumTeddy, First200FramesAllPosedWithLowAte) {
   DYNAMAP_REQUIRE_SHARED_DATA();
   ASSERT_GE(teddyFrames().size(), 190u);
@@ -112,6 +123,9 @@ TEST(TumTeddy, First200FramesAllPosedWithLowAte) {
     std::cout << "[teddy200] " << stage << ": n=" << st.count << " median " << st.median_ms
               << " ms, p95 " << st.p95_ms << " ms, max " << st.max_ms << " ms\n";
   }
+  std::cout << "[teddy200] tracking CPU time of the calling thread: median "
+            << percentile(run.cpu_ms, 50) << " ms, p95 " << percentile(run.cpu_ms, 95)
+            << " ms (wall-clock stages above include waiting for a core on a loaded machine)\n";
   EXPECT_EQ(posed, n);
   EXPECT_GT(run.gt_matched, n * 9 / 10);
   EXPECT_LE(run.ate_m, 0.03);

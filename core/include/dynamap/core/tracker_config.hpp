@@ -17,8 +17,8 @@ struct TrackerConfig {
   // --- Lucas-Kanade frame-to-frame matching ---
   int lk_levels = 6;                ///< pyramid levels of Lucas-Kanade optical flow
   double lk_scale = 0.5;            ///< scale between pyramid levels
-  int lk_window_px = 21;            ///< LK window side
-  int lk_max_iterations = 30;       ///< LK iterations per level
+  int lk_window_px = 15;            ///< LK window side
+  int lk_max_iterations = 20;       ///< LK iterations per level
   double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
 
   // --- depth ---
