@@ -205,6 +205,8 @@ int main(int argc, char** argv) {
                  "dynamic.reprojection_threshold_px");
   app.add_option("--rigid-epipolar-threshold", config.rigid_epipolar_threshold_px,
                  "dynamic.rigid_epipolar_threshold_px");
+  app.add_option("--boxed-fit-weight", config.boxed_fit_weight, "dynamic.boxed_fit_weight");
+  app.add_option("--masked-fit-weight", config.masked_fit_weight, "dynamic.masked_fit_weight");
   app.add_option("--moving-ratio", config.moving_ratio, "dynamic.moving_ratio");
   app.add_option("--evidence-smoothing", config.evidence_smoothing, "dynamic.evidence_smoothing");
   app.add_option("--geometric-check", config.geometric_check, "rigid | epipolar");

@@ -15,6 +15,8 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.rigid_epipolar_threshold_px", &c.rigid_epipolar_threshold_px, 0.01,
                    100.0);
   schema.addInt("dynamic.bucket_px", &c.bucket_px, 1, 1000);
+  schema.addDouble("dynamic.boxed_fit_weight", &c.boxed_fit_weight, 0.0, 1.0);
+  schema.addDouble("dynamic.masked_fit_weight", &c.masked_fit_weight, 0.0, 1.0);
   schema.addString("dynamic.detector", &c.detector,
                    {"yolo_darknet", "yolov5_onnx", "yolov8_onnx", "nanodet_onnx", "none"});
   schema.addString("dynamic.model_cfg", &c.model_cfg);

@@ -189,26 +189,21 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
   if (config_.geometric_check == "epipolar" || depth.empty()) {
     return checkEpipolar(m.prev_px, m.cur_px, eo);
   }
-  // Matches on last frame's moving regions and inside high-dynamic boxes do not vote for the
-  // camera motion (a large textured mover can otherwise out-vote a nearly planar background),
-  // unless too few others remain.
+  // Matches on last frame's moving regions and inside high-dynamic boxes count less when
+  // voting for the camera motion (a large textured mover can otherwise out-vote a nearly
+  // planar background); they are never excluded, so a wrong mask cannot lock itself in.
   const std::size_t n = m.cur_px.size();
-  std::vector<std::uint8_t> outside_mask(n, 1), outside_all(n, 1);
+  std::vector<float> weight(n, 1.f);
   for (std::size_t i = 0; i < n; ++i) {
-    outside_mask[i] = inMask(prev_mask_, m.cur_px[i]) ? 0 : 1;
-    outside_all[i] = outside_mask[i];
+    if (inMask(prev_mask_, m.cur_px[i])) weight[i] *= static_cast<float>(config_.masked_fit_weight);
     for (const auto& d : dets) {
-      if (classes_.isHighDynamic(d.class_id) && d.box.contains(m.cur_px[i])) outside_all[i] = 0;
+      if (classes_.isHighDynamic(d.class_id) && d.box.contains(m.cur_px[i])) {
+        weight[i] *= static_cast<float>(config_.boxed_fit_weight);
+        break;
+      }
     }
   }
-  const auto enough = [&](const std::vector<std::uint8_t>& v) {
-    const auto c = std::count(v.begin(), v.end(), 1);
-    return c >= config_.min_matches && 4 * c >= static_cast<long>(n);
-  };
-  const std::vector<std::uint8_t> none;
-  const auto& may_fit =
-      enough(outside_all) ? outside_all : (enough(outside_mask) ? outside_mask : none);
-  return checkRigidMotion(m.prev_px, m.cur_px, depth, K_, may_fit, eo, &motion_);
+  return checkRigidMotion(m.prev_px, m.cur_px, depth, K_, weight, eo, &motion_);
 }
 
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {

@@ -59,20 +59,58 @@ struct PoseFit {
   bool ok = false;
 };
 
-/// PnP-RANSAC (EPnP samples) + Levenberg-Marquardt refinement on the inliers.
+/// Points within `threshold_px` of the pose's reprojection and their summed weight.
+double scorePose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
+                 const std::vector<float>& w, const cv::Matx33d& K, const cv::Mat& rvec,
+                 const cv::Mat& tvec, double threshold_px, std::vector<int>* inliers) {
+  std::vector<cv::Point2f> proj;
+  cv::projectPoints(X, rvec, tvec, K, cv::noArray(), proj);
+  double score = 0.0;
+  if (inliers != nullptr) inliers->clear();
+  for (std::size_t k = 0; k < X.size(); ++k) {
+    if (cv::norm(proj[k] - p[k]) > threshold_px) continue;
+    score += w[k];
+    if (inliers != nullptr) inliers->push_back(static_cast<int>(k));
+  }
+  return score;
+}
+
+/// RANSAC over minimal 4-point (AP3P) samples scored by the summed weight of the inliers (so
+/// matches on likely movers count less), then Levenberg-Marquardt on the inliers (twice).
+/// Deterministic (fixed seed).
 PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
-                const cv::Matx33d& K, double threshold_px, double confidence) {
+                const std::vector<float>& w, const cv::Matx33d& K, double threshold_px,
+                int iterations) {
   PoseFit f;
-  if (static_cast<int>(X.size()) < kMinFitPoints) return f;
-  f.ok = cv::solvePnPRansac(X, p, K, cv::noArray(), f.rvec, f.tvec, false, 300,
-                            static_cast<float>(threshold_px), confidence, f.inliers,
-                            cv::SOLVEPNP_EPNP) &&
-         static_cast<int>(f.inliers.size()) >= kMinFitPoints / 2;
-  if (!f.ok) return f;
-  std::vector<cv::Point3f> ix;
-  std::vector<cv::Point2f> ip;
-  for (int k : f.inliers) ix.push_back(X[k]), ip.push_back(p[k]);
-  cv::solvePnPRefineLM(ix, ip, K, cv::noArray(), f.rvec, f.tvec);
+  const int n = static_cast<int>(X.size());
+  if (n < kMinFitPoints) return f;
+  cv::RNG rng(0x5eed);
+  double best = 0.0;
+  std::vector<cv::Point3f> sx(4);
+  std::vector<cv::Point2f> sp(4);
+  for (int it = 0; it < iterations; ++it) {
+    int idx[4];
+    for (int k = 0; k < 4; ++k) {
+      do {
+        idx[k] = rng.uniform(0, n);
+      } while (std::find(idx, idx + k, idx[k]) != idx + k);
+      sx[k] = X[idx[k]], sp[k] = p[idx[k]];
+    }
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(sx, sp, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_AP3P)) continue;
+    const double score = scorePose(X, p, w, K, rvec, tvec, threshold_px, nullptr);
+    if (score > best) best = score, f.rvec = rvec, f.tvec = tvec;
+  }
+  if (f.rvec.empty()) return f;
+  for (int round = 0; round < 2; ++round) {
+    scorePose(X, p, w, K, f.rvec, f.tvec, threshold_px, &f.inliers);
+    if (static_cast<int>(f.inliers.size()) < kMinFitPoints / 2) return f;
+    std::vector<cv::Point3f> ix;
+    std::vector<cv::Point2f> ip;
+    for (int k : f.inliers) ix.push_back(X[k]), ip.push_back(p[k]);
+    cv::solvePnPRefineLM(ix, ip, K, cv::noArray(), f.rvec, f.tvec);
+  }
+  f.ok = true;
   return f;
 }
 
@@ -80,7 +118,7 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
 
 EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
                                 const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
-                                const cv::Vec4d& K, const std::vector<std::uint8_t>& may_fit,
+                                const cv::Vec4d& K, const std::vector<float>& fit_weight,
                                 const EpipolarOptions& o, RigidMotion* estimated) {
   if (estimated != nullptr) *estimated = RigidMotion{};
   const std::size_t n = std::min(prev_px.size(), cur_px.size());
@@ -105,7 +143,7 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
     const float z_fit = z[i] > 0.f ? z[i] : (beyondRange(depth_m, cur_px[i]) ? kFarDepthM : 0.f);
     X[i] = cv::Point3f(static_cast<float>((cur_px[i].x - K[2]) * z_fit / K[0]),
                        static_cast<float>((cur_px[i].y - K[3]) * z_fit / K[1]), z_fit);
-    if (z_fit <= 0.f || (!may_fit.empty() && (i >= may_fit.size() || !may_fit[i]))) continue;
+    if (z_fit <= 0.f) continue;
     auto& c = cells[{cvFloor(cur_px[i].x / bucket), cvFloor(cur_px[i].y / bucket)}];
     if (c++ < 2) fit.push_back(static_cast<int>(i));
   }
@@ -113,10 +151,14 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
 
   std::vector<cv::Point3f> fx;
   std::vector<cv::Point2f> fp;
-  for (int i : fit) fx.push_back(X[i]), fp.push_back(prev_px[i]);
+  std::vector<float> fw;
+  for (int i : fit) {
+    fx.push_back(X[i]), fp.push_back(prev_px[i]);
+    fw.push_back(static_cast<std::size_t>(i) < fit_weight.size() ? fit_weight[i] : 1.f);
+  }
   const cv::Matx33d Km(K[0], 0, K[2], 0, K[1], K[3], 0, 0, 1);
   const double fit_thr = 0.5 * o.reprojection_threshold_px;
-  PoseFit best = fitPose(fx, fp, Km, fit_thr, o.confidence);
+  PoseFit best = fitPose(fx, fp, fw, Km, fit_thr, o.ransac_iterations);
   if (!best.ok) return checkEpipolar(prev_px, cur_px, o);
   const cv::Mat& rvec = best.rvec;
   const cv::Mat& tvec = best.tvec;

@@ -27,10 +27,12 @@ struct DynamicConfig {
   /// rigid: PnP with the current depth (reprojection error; epipolar distance to the pose's F
   /// for matches without depth); epipolar: fundamental matrix only (no depth).
   std::string geometric_check = "rigid";
-  double reprojection_threshold_px = 4.0;
+  double reprojection_threshold_px = 4.5;
   /// rigid check, matches without depth: symmetric epipolar distance to the PnP pose's F
   double rigid_epipolar_threshold_px = 2.5;
-  int bucket_px = 40;  ///< model fits use at most 2 matches per bucket_px cell
+  int bucket_px = 40;               ///< model fits use at most 2 matches per bucket_px cell
+  double boxed_fit_weight = 0.2;    ///< vote of a match inside a high-dynamic box (rigid fit)
+  double masked_fit_weight = 0.05;  ///< vote of a match inside last frame's mask (rigid fit)
 
   // --- detector -----------------------------------------------------------------------------
   std::string detector = "yolo_darknet";  ///< yolo_darknet | yolov5_onnx | yolov8_onnx |
@@ -58,10 +60,10 @@ struct DynamicConfig {
   std::map<std::string, std::string> class_weights{{"person", "1.0"}, {"chair", "0.5"}};
 
   // --- fusion -------------------------------------------------------------------------------
-  double moving_ratio = 0.5;         ///< weighted share of dynamic points to call an object moving
+  double moving_ratio = 0.7;         ///< weighted share of dynamic points to call an object moving
   int min_object_points = 4;         ///< tracked points needed inside an object to decide
   int min_dynamic_points = 3;        ///< dynamic points needed inside an object to call it moving
-  double evidence_smoothing = 0.5;   ///< weight of the past in the per-object motion evidence
+  double evidence_smoothing = 0.6;   ///< weight of the past in the per-object motion evidence
   double depth_band_m = 0.4;         ///< object pixels: within this of the object's depth mode
   int mask_dilation_px = 7;          ///< final dilation of each region
   double cluster_radius_px = 40;     ///< dynamic points closer than this form one cluster

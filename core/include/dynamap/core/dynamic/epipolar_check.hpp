@@ -15,6 +15,7 @@ struct EpipolarOptions {
   double homography_inlier_ratio = 0.85;
   double reprojection_threshold_px = 4.0;    ///< rigid check (with depth): reprojection error
   double rigid_epipolar_threshold_px = 2.5;  ///< rigid check, matches without depth
+  int ransac_iterations = 200;               ///< rigid check: minimal-sample iterations
   int bucket_px = 40;                        ///< model fit uses at most 2 matches per cell
 };
 
@@ -53,8 +54,10 @@ struct RigidMotion {
 
 /// The same check made well-conditioned with the current depth (RGB-D): the static camera
 /// motion is a PnP-RANSAC pose from the current frame's 3-D points to the previous pixels,
-/// fitted on a spatially bucketed subset of the matches with `may_fit` set (so a large, richly
-/// textured moving person cannot out-vote the background), refined on its inliers.
+/// fitted on a spatially bucketed subset of the matches (at most 2 per bucket_px cell) where
+/// each inlier counts with its `fit_weight` (low on likely movers: detected people, last
+/// frame's moving regions), so a large, richly textured mover cannot out-vote the background;
+/// refined on its inliers.
 /// A match with depth is dynamic if its reprojection error exceeds reprojection_threshold_px;
 /// one without depth if its symmetric epipolar distance to the pose's F exceeds
 /// rigid_epipolar_threshold_px.
@@ -62,10 +65,11 @@ struct RigidMotion {
 /// as far points: they pin the rotation that a near, nearly planar static layer leaves
 /// ambiguous with translation (which lets a large mover's motion fit the static layer to ~1 px).
 /// Falls back to checkEpipolar() when too few matches have depth.
-/// `K` = (fx, fy, cx, cy); `may_fit` empty = all; `estimated` (may be null) gets the motion.
+/// `K` = (fx, fy, cx, cy); `fit_weight` per match (empty = all 1); `estimated` (may be null)
+/// gets the motion.
 EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
                                 const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
-                                const cv::Vec4d& K, const std::vector<std::uint8_t>& may_fit,
+                                const cv::Vec4d& K, const std::vector<float>& fit_weight,
                                 const EpipolarOptions& options, RigidMotion* estimated = nullptr);
 
 }  // namespace dynamap
