@@ -8,5 +8,6 @@ namespace dynamap {
 /// process exit code in `*exit_code`. Explicit registry: main.cpp calls each of these.
 void addRunCommand(CLI::App& app, int* exit_code);
 void addEvaluateCommand(CLI::App& app, int* exit_code);
+void addExportCommand(CLI::App& app, int* exit_code);
 
 }  // namespace dynamap

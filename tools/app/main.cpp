@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   dynamap::addRunCommand(app, &exit_code);
   dynamap::addEvaluateCommand(app, &exit_code);
+  dynamap::addExportCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

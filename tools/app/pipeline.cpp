@@ -71,6 +71,9 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
     : options_(options), config_(config), sequence_(sequence), stages_(std::make_unique<Stages>()) {
   auto& s = *stages_;
   s.camera = config_.resolvedCamera();
+  if (fs::is_directory(fs::path(sequence_.directory()) / "mask")) {
+    gt_masks_dir_ = (fs::path(sequence_.directory()) / "mask").string();
+  }
 
   // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
   const auto registry = BackendRegistry::scan(pluginSearchPath());
@@ -173,11 +176,20 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
   const TrackingResult tracked = s.tracker->track(frame);
   if (tracked.is_keyframe && tracked.keyframe) {
     s.mapper->push(tracked.keyframe);
+    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, tracked, result);
     if (options_.save_masks) writeKeyframeMask(entry, tracked);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
   const auto updates = s.tracker->takePoseUpdates();
   if (!updates.empty()) s.mapper->applyPoseUpdates(updates);
+}
+
+void Pipeline::scoreKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked,
+                                 RunResult& result) const {
+  const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
+  const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (gt.empty() || gt.size() != tracked.keyframe->bgr.size()) return;  // no usable truth
+  result.mask_scores.add(scoreMask(tracked.keyframe->dynamic_mask, gt));
 }
 
 void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const {

@@ -7,6 +7,7 @@
 #include "app_config.hpp"
 #include "dynamap/core/frame.hpp"
 #include "dynamap/core/timing.hpp"
+#include "mask_eval.hpp"
 #include "run_options.hpp"
 #include "trajectory_io.hpp"
 #include "tum_dataset.hpp"
@@ -37,6 +38,8 @@ struct RunResult {
   double wall_time_s = 0.0;
   std::string backend;
   std::string map_dir;
+  /// Keyframe masks vs the sequence's ground-truth masks (DIR/mask/), when it has them.
+  MaskScoreSummary mask_scores;
 };
 
 /// The run: frames -> tracking (with motion-area removal) -> keyframes -> mapping.
@@ -59,6 +62,8 @@ class Pipeline {
   void processFrames(RunResult& result);
   void processFrame(std::size_t index, RunResult& result);
   void finalize(RunResult& result);
+  void scoreKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked,
+                         RunResult& result) const;
   void writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
                        const TrackingResult& tracked) const;
@@ -68,6 +73,7 @@ class Pipeline {
   const TumSequence& sequence_;
   TimingRecorder timings_;
   std::unique_ptr<Stages> stages_;
+  std::string gt_masks_dir_;  ///< sequence_dir/mask when present
 };
 
 }  // namespace dynamap

@@ -117,6 +117,10 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
       report.warnings += std::string("map metrics skipped: ") + e.what() + "\n";
     }
   }
+  if (result.mask_scores.frames() > 0) {
+    const std::string masks = "{\"masks\": " + result.mask_scores.toJson() + "}";
+    metrics_json = metrics_json.empty() ? masks : mergeJsonObjects(metrics_json, masks);
+  }
   if (!metrics_json.empty()) {
     writeTextFileAtomic(outPath(options, "metrics.json"), metrics_json + "\n");
   }
@@ -133,6 +137,9 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
   if (!result.error.empty()) out << "error: " << result.error << "\n";
   if (report.evaluation) out << evaluationToTable(*report.evaluation);
   if (!report.map_metrics_json.empty()) out << "map: " << report.map_metrics_json << "\n";
+  if (result.mask_scores.frames() > 0) {
+    out << "keyframe masks vs ground truth: " << result.mask_scores.toJson() << "\n";
+  }
   out << report.warnings;
   out << "outputs in " << options.out_dir << " (map: " << result.map_dir << ")\n";
 }
