@@ -39,6 +39,8 @@ AppConfig loadAppConfig(const std::string& config_path, const std::vector<std::s
   bindAppConfig(schema, config);
   if (!config_path.empty()) schema.loadYamlFile(config_path);
   for (const auto& o : overrides) schema.applyOverride(o);
+  // Relative detector model paths: CWD first, then the config file's directory's parent.
+  resolveDynamicModelPaths(config.dynamic, config_path);
   if (effective_yaml != nullptr) *effective_yaml = schema.dumpYaml();
   return config;
 }

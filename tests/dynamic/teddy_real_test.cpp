@@ -1,0 +1,57 @@
+// Short real-data check on teddy_dyn_dev (frames 20-40: two walkers and the standing person
+// in view), without the tracker: LK matches between consecutive frames, the motion filter,
+// masks scored against the ground-truth person masks. Bounds are set below what the default
+// configuration reaches on these frames (IoU 0.82, standing 0.0 %, teddy 0.1 %, see the bench
+// in tools/bench_dynamic) so that the test fails on a real regression, not on noise.
+#include <gtest/gtest.h>
+
+#include "../../tools/bench_dynamic/dynamic_harness.hpp"
+#include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
+#include "test_paths.hpp"
+
+namespace dynamap {
+namespace {
+
+struct RunScore {
+  double mean_iou = 0.0, standing = 0.0, teddy = 0.0;
+};
+
+RunScore run(const std::string& mode, int first, int count) {
+  DynamicConfig c;
+  c.mode = mode;
+  resolveDynamicModelPaths(c, (test::sourceDir() / "config/default.yaml").string());
+  DynamicMotionFilter filter(c, PinholeCamera{}, nullptr);
+  const dynbench::DynSequence seq(test::sharedData() / "dynamic/teddy_dyn_dev");
+  dynbench::SequenceFrame prev = seq.load(first);
+  double iou_sum = 0.0;
+  int iou_n = 0;
+  long st = 0, st_m = 0, td = 0, td_m = 0;
+  for (int i = first + 1; i <= first + count; ++i) {
+    dynbench::SequenceFrame cur = seq.load(i);
+    filter.beginFrame(cur.frame);
+    const FeatureMatches m = dynbench::trackLk(prev.gray, cur.gray);
+    const MotionFilterOutput out = filter.filter({&cur.frame, &prev.gray, &cur.gray, &m});
+    EXPECT_EQ(out.match_is_dynamic.size(), m.cur_px.size());
+    const auto s = dynbench::scoreMask(out.dynamic_mask, cur.gt_mask, cur.teddy_mask);
+    if (s.moving_visible) iou_sum += s.iou, ++iou_n;
+    st += s.standing_px, st_m += s.standing_masked_px, td += s.teddy_px, td_m += s.teddy_masked_px;
+    prev = std::move(cur);
+  }
+  return {iou_n ? iou_sum / iou_n : 0.0, st ? double(st_m) / st : 0.0,
+          td ? double(td_m) / td : 0.0};
+}
+
+TEST(TeddyDynDev, FusionMasksWalkersAndKeepsTheStandingPersonAndTheTeddy) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const RunScore both = run("both", 19, 20);
+  EXPECT_GE(both.mean_iou, 0.65);
+  EXPECT_LE(both.standing, 0.10);
+  EXPECT_LE(both.teddy, 0.05);
+  // The naive baseline masks every detected person, the standing one included.
+  const RunScore naive = run("detector", 19, 20);
+  EXPECT_GE(naive.standing, 0.5);
+  EXPECT_GT(both.mean_iou, naive.mean_iou);
+}
+
+}  // namespace
+}  // namespace dynamap
