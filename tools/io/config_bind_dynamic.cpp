@@ -7,6 +7,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.epipolar_threshold_px", &c.epipolar_threshold_px, 0.01, 100.0);
   schema.addInt("dynamic.min_matches", &c.min_matches, 8, 100000);
   schema.addDouble("dynamic.min_parallax_px", &c.min_parallax_px, 0.0, 1000.0);
+  schema.addInt("dynamic.ransac_iterations", &c.ransac_iterations, 10, 100000);
   schema.addDouble("dynamic.ransac_confidence", &c.ransac_confidence, 0.5, 0.999999);
   schema.addDouble("dynamic.homography_inlier_ratio", &c.homography_inlier_ratio, 0.0, 10.0);
 
@@ -29,6 +30,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.nms_iou_threshold", &c.nms_iou_threshold, 0.0, 1.0);
   schema.addString("dynamic.nms", &c.nms, {"plain", "recall"});
   schema.addDouble("dynamic.soft_nms_sigma", &c.soft_nms_sigma, 0.01, 10.0);
+  schema.addDouble("dynamic.nms_dedup_iou", &c.nms_dedup_iou, 0.0, 1.0);
   schema.addInt("dynamic.detector_threads", &c.detector_threads, 0, 256);
 
   schema.addStringList("dynamic.high_dynamic_classes", &c.high_dynamic_classes);

@@ -138,6 +138,7 @@ DetectorOptions detectorOptions(const DynamicConfig& c) {
   o.nms.iou_threshold = static_cast<float>(c.nms_iou_threshold);
   o.nms.score_threshold = static_cast<float>(c.score_threshold);
   o.nms.soft_sigma = static_cast<float>(c.soft_nms_sigma);
+  o.nms.dedup_iou = static_cast<float>(c.nms_dedup_iou);
   return o;
 }
 
@@ -186,6 +187,7 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
   eo.reprojection_threshold_px = config_.reprojection_threshold_px;
   eo.rigid_epipolar_threshold_px = config_.rigid_epipolar_threshold_px;
   eo.bucket_px = config_.bucket_px;
+  eo.ransac_iterations = config_.ransac_iterations;
   if (config_.geometric_check == "epipolar" || depth.empty()) {
     return checkEpipolar(m.prev_px, m.cur_px, eo);
   }

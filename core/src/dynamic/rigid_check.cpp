@@ -12,6 +12,7 @@ namespace {
 
 constexpr int kMinFitPoints = 12;
 constexpr float kFarDepthM = 12.f;
+constexpr int kMinIterations = 60;
 
 /// Depth at `p` if valid and not on a depth edge (5x5 range < 5 % of the depth), else 0.
 float stableDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
@@ -77,6 +78,7 @@ double scorePose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2
 
 /// RANSAC over minimal 4-point (AP3P) samples scored by the summed weight of the inliers (so
 /// matches on likely movers count less), then Levenberg-Marquardt on the inliers (twice).
+/// Adaptive number of iterations (at least kMinIterations, at most `iterations`).
 /// Deterministic (fixed seed).
 PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
                 const std::vector<float>& w, const cv::Matx33d& K, double threshold_px,
@@ -86,9 +88,10 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
   if (n < kMinFitPoints) return f;
   cv::RNG rng(0x5eed);
   double best = 0.0;
+  int needed = iterations;
   std::vector<cv::Point3f> sx(4);
   std::vector<cv::Point2f> sp(4);
-  for (int it = 0; it < iterations; ++it) {
+  for (int it = 0; it < std::min(iterations, std::max(kMinIterations, needed)); ++it) {
     int idx[4];
     for (int k = 0; k < 4; ++k) {
       do {
@@ -98,8 +101,15 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
     }
     cv::Mat rvec, tvec;
     if (!cv::solvePnP(sx, sp, K, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_AP3P)) continue;
-    const double score = scorePose(X, p, w, K, rvec, tvec, threshold_px, nullptr);
-    if (score > best) best = score, f.rvec = rvec, f.tvec = tvec;
+    std::vector<int> inl;
+    const double score = scorePose(X, p, w, K, rvec, tvec, threshold_px, &inl);
+    if (score <= best) continue;
+    best = score, f.rvec = rvec, f.tvec = tvec;
+    // Adaptive stop (99.9 % to draw one all-inlier sample), never before kMinIterations.
+    const double ratio = static_cast<double>(inl.size()) / n;
+    const double miss = 1.0 - ratio * ratio * ratio * ratio;
+    needed = miss <= 1e-9 ? 0 : static_cast<int>(std::ceil(std::log(1e-3) / std::log(miss)));
+    if (it + 1 >= std::max(kMinIterations, needed)) break;
   }
   if (f.rvec.empty()) return f;
   for (int round = 0; round < 2; ++round) {

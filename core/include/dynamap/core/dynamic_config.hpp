@@ -21,6 +21,7 @@ struct DynamicConfig {
   int min_matches = 30;          ///< fewer matches: flag nothing (degenerate)
   double min_parallax_px = 0.3;  ///< median flow below this: flag nothing (no information)
   double ransac_confidence = 0.999;
+  int ransac_iterations = 200;  ///< rigid check: at most this many minimal samples
   /// Homography explains >= this share of the F inliers: low parallax / pure rotation; the
   /// homography transfer error is used instead of the ill-conditioned epipolar distance.
   double homography_inlier_ratio = 0.85;
@@ -44,9 +45,11 @@ struct DynamicConfig {
   double score_threshold = 0.25;               ///< low-dynamic classes
   double high_dynamic_score_threshold = 0.15;  ///< high-dynamic classes (recall first)
   double nms_iou_threshold = 0.45;
-  std::string nms = "recall";   ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)
-  double soft_nms_sigma = 0.5;  ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
-  int detector_threads = 0;     ///< >0: cv::setNumThreads on first detection (process-wide)
+  std::string nms = "recall";  ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)
+  double soft_nms_sigma = 0.5;
+  double nms_dedup_iou = 0.7;  ///< recall NMS: duplicates above this IoU are dropped after soft-NMS
+                               ///< ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
+  int detector_threads = 0;    ///< >0: cv::setNumThreads on first detection (process-wide)
 
   // --- class table --------------------------------------------------------------------------
   /// COCO names of high-dynamic classes (can move by themselves).
