@@ -89,7 +89,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   record(frame.timestamp_s, result.status, result.T_W_C);
   countStatus(result.status, result.is_keyframe);
   prev_pyramid_ = std::move(pyramid);
-  prev_gray_ = gray;
+  // A grey input is used as is: copy it so the caller may reuse its buffer.
+  prev_gray_ = gray.data == frame.bgr.data ? gray.clone() : gray;
   return result;
 }
 

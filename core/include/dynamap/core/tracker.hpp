@@ -44,6 +44,17 @@ struct KeyframeInfo {
 /// refinement against a local map of landmarks, keyframes, local bundle adjustment on its own
 /// thread and relocalization. The world frame is the camera frame of the first tracked frame.
 ///
+/// Per frame: LK (seeded by a constant-velocity prediction, forward-backward checked) moves the
+/// tracked features; the motion filter (if any) drops dynamic ones; PnP-RANSAC + Ceres refine
+/// the pose (reprojection + depth residuals); if that fails, relocalization by ORB matching
+/// against recent keyframes' landmarks; otherwise kLost with the last known pose.
+/// Keyframe policy (TrackerConfig): a new keyframe when tracked features < min_tracked_features,
+/// or < kf_min_tracked_ratio of those of the reference keyframe, or the camera moved more than
+/// kf_max_translation_m / kf_max_rotation_deg, or the median feature parallax exceeds
+/// kf_max_parallax_px, or kf_max_interval_s passed since the reference keyframe. Only keyframes
+/// extract ORB features (in grid cells without a tracked feature, outside the dynamic mask) and
+/// create landmarks (depth in [depth_min_m, landmark_depth_max_m]).
+///
 /// Threading: track(), markBadFrame(), setMotionFilter(), finish() and the trajectory getters are
 /// called from one (the tracking) thread. takePoseUpdates() and stats() are thread-safe.
 class Tracker {
