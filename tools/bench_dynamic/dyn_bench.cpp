@@ -88,6 +88,37 @@ struct ModeSummary {
   int frames = 0;
 };
 
+/// One line per frame: scores, median residual per ground-truth class, the objects.
+void printFrameDetails(int i, const dynbench::MaskScore& s, const dynbench::SequenceFrame& cur,
+                       const FeatureMatches& matches, const DynamicMotionFilter& filter) {
+  const auto& diag = filter.lastDiagnostics();
+  std::vector<double> r[3];
+  for (std::size_t k = 0; k < matches.cur_px.size() && k < diag.residual_px.size(); ++k) {
+    const uchar g =
+        cur.gt_mask.at<uchar>(cvRound(matches.cur_px[k].y), cvRound(matches.cur_px[k].x));
+    r[g == 255 ? 0 : (g == 128 ? 1 : 2)].push_back(diag.residual_px[k]);
+  }
+  auto med = [](std::vector<double> v) { return v.empty() ? -1.0 : percentile(v, 50); };
+  std::printf(
+      "  frame %d iou %.2f standing %.2f teddy %.2f | median residual moving %.1f (%zu) "
+      "standing %.1f (%zu) static %.1f (%zu)\n",
+      i, s.iou, s.standing_masked, s.teddy_masked, med(r[0]), r[0].size(), med(r[1]), r[1].size(),
+      med(r[2]), r[2].size());
+  for (const auto& o : diag.objects) {
+    const cv::Rect b = cv::Rect(o.detection.box) & cv::Rect(0, 0, 640, 480);
+    const double st_share =
+        b.area() ? cv::countNonZero(cur.gt_mask(b) == 128) / double(b.area()) : 0.0;
+    const double mv_share =
+        b.area() ? cv::countNonZero(cur.gt_mask(b) == 255) / double(b.area()) : 0.0;
+    std::printf(
+        "     obj %s %.2f pts %d dyn %d now %d moving %d depth %.2f | box standing %.2f moving "
+        "%.2f\n",
+        filter.classTable().name(o.detection.class_id).c_str(), o.detection.score, o.points,
+        o.dynamic_points, o.moving_now, o.moving, o.depth_m, st_share, mv_share);
+  }
+  std::printf("     clusters %d\n", diag.clusters);
+}
+
 ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::DynSequence& seq,
                     int first, int count, const std::string& debug_dir, bool verbose) {
   c.mode = mode;
@@ -111,33 +142,7 @@ ModeSummary runMode(DynamicConfig c, const std::string& mode, const dynbench::Dy
     const auto s = dynbench::scoreMask(out.dynamic_mask, cur.gt_mask, cur.teddy_mask);
     if (s.moving_visible) iou_sum += s.iou, ++iou_n;
     const auto& diag = filter.lastDiagnostics();
-    if (verbose) {
-      std::vector<double> r[3];
-      for (std::size_t k = 0; k < matches.cur_px.size() && k < diag.residual_px.size(); ++k) {
-        const uchar g =
-            cur.gt_mask.at<uchar>(cvRound(matches.cur_px[k].y), cvRound(matches.cur_px[k].x));
-        r[g == 255 ? 0 : (g == 128 ? 1 : 2)].push_back(diag.residual_px[k]);
-      }
-      auto med = [](std::vector<double> v) { return v.empty() ? -1.0 : percentile(v, 50); };
-      std::printf(
-          "  frame %d iou %.2f standing %.2f teddy %.2f | median residual moving %.1f (%zu) "
-          "standing %.1f (%zu) static %.1f (%zu)\n",
-          i, s.iou, s.standing_masked, s.teddy_masked, med(r[0]), r[0].size(), med(r[1]),
-          r[1].size(), med(r[2]), r[2].size());
-      for (const auto& o : diag.objects) {
-        const cv::Rect b = cv::Rect(o.detection.box) & cv::Rect(0, 0, 640, 480);
-        const double st_share =
-            b.area() ? cv::countNonZero(cur.gt_mask(b) == 128) / double(b.area()) : 0.0;
-        const double mv_share =
-            b.area() ? cv::countNonZero(cur.gt_mask(b) == 255) / double(b.area()) : 0.0;
-        std::printf(
-            "     obj %s %.2f pts %d dyn %d now %d moving %d depth %.2f | box standing %.2f moving "
-            "%.2f\n",
-            filter.classTable().name(o.detection.class_id).c_str(), o.detection.score, o.points,
-            o.dynamic_points, o.moving_now, o.moving, o.depth_m, st_share, mv_share);
-      }
-      std::printf("     clusters %d\n", diag.clusters);
-    }
+    if (verbose) printFrameDetails(i, s, cur, matches, filter);
     ++model_count[static_cast<int>(diag.model)];
     for (std::size_t k = 0; k < matches.cur_px.size(); ++k) {
       const uchar g =

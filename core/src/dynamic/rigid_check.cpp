@@ -12,7 +12,7 @@ namespace {
 
 constexpr int kMinFitPoints = 12;
 constexpr float kFarDepthM = 12.f;
-constexpr int kMinIterations = 60;
+constexpr int kMinIterations = 120;
 
 /// Depth at `p` if valid and not on a depth edge (5x5 range < 5 % of the depth), else 0.
 float stableDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
