@@ -152,8 +152,8 @@ TEST(MapPreview, UpFromCamerasThatYawAndPitch) {
   }
   const Eigen::Vector3f up = estimateUp(points, trajectory);
   EXPECT_GT(up.dot(Eigen::Vector3f::UnitZ()), std::cos(2.0 * M_PI / 180.0));
-  // Without cameras: the floor normal, sign made positive.
-  EXPECT_GT(std::abs(estimateUp(points, {}).z()), std::cos(2.0 * M_PI / 180.0));
+  // Without cameras: the smallest principal axis, which the off-centre box tilts (~3 degrees).
+  EXPECT_GT(estimateUp(points, {}).z(), std::cos(5.0 * M_PI / 180.0));
 }
 
 TEST(MapPreview, CamerasFrameTheMapAndTopLooksDown) {
@@ -166,7 +166,7 @@ TEST(MapPreview, CamerasFrameTheMapAndTopLooksDown) {
   EXPECT_TRUE(cams[0].orthographic);
   // Top camera's viewing axis (z_C in world) is along -up.
   const Eigen::Vector3f z_W = cams[0].T_C_W.linear().row(2).transpose();
-  EXPECT_GT(std::abs(z_W.z()), 0.999f);
+  EXPECT_GT(std::abs(z_W.z()), std::cos(5.0 * M_PI / 180.0));  // PCA up, see above
   for (const PreviewCamera& cam : cams) {
     int in_image = 0;
     for (const auto& p_W : points) {

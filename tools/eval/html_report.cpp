@@ -14,12 +14,15 @@
 #include "image_io.hpp"
 #include "json_reader.hpp"
 #include "map_preview.hpp"
+#include "ply_colored.hpp"
 #include "trajectory_eval.hpp"
 #include "trajectory_plot.hpp"
 
 namespace dynamap {
 namespace {
 namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxPreviewPoints = 2000000;  ///< big clouds: every k-th point
 
 struct ReportInputs {
   std::string out_dir;
@@ -86,8 +89,8 @@ void writePreviews(ReportInputs* in) {
     return;
   }
   try {
-    const PlyData map = readPly(path(*in, in->map_file), /*with_faces=*/true);
-    in->map_vertices = map.vertices.size();
+    const PlyData map =
+        readPlyForPreview(path(*in, in->map_file), kMaxPreviewPoints, &in->map_vertices);
     in->map_triangles = map.triangles.size();
     std::vector<TimedPose> trajectory;
     if (fs::exists(path(*in, "trajectory.txt"))) {
@@ -170,6 +173,8 @@ std::string format(const std::string& key, const JsonValue& v) {
     std::snprintf(text, sizeof(text), "%.2f s", x);
   } else if (std::abs(x) < 1e15 && x == std::floor(x)) {
     std::snprintf(text, sizeof(text), "%.0f", x);
+  } else if (std::abs(x) < 0.01) {
+    std::snprintf(text, sizeof(text), "%.3g", x);  // e.g. a ghost ratio of 1.4e-06
   } else {
     std::snprintf(text, sizeof(text), "%.3f", x);
   }
@@ -223,13 +228,14 @@ std::string metricsSection(const ReportInputs& in) {
   if (!in.metrics)
     return html.str() + "<p>metrics.json not available (no ground truth?).</p></section>\n";
   html << "<div class=\"row\">\n";
-  const std::pair<const char*, const char*> parts[] = {{"ate", "ATE (absolute trajectory error)"},
-                                                       {"rpe", "RPE (relative pose error)"},
-                                                       {"map", "Map vs reference"}};
-  for (const auto& [key, caption] : parts) {
-    if (const JsonValue* part = in.metrics->find(key); part && part->isObject()) {
-      html << keyValueTable(caption, *part);
-    }
+  // Every object of metrics.json gets a table (ate, rpe, map and whatever is added later).
+  for (const auto& [key, part] : in.metrics->members()) {
+    if (!part.isObject()) continue;
+    const std::string caption = key == "ate"   ? "ATE (absolute trajectory error)"
+                                : key == "rpe" ? "RPE (relative pose error)"
+                                : key == "map" ? "Map vs reference"
+                                               : label(key);
+    html << keyValueTable(caption, part);
   }
   return html.str() + "</div></section>\n";
 }
@@ -250,7 +256,7 @@ std::string mapSection(const ReportInputs& in) {
   html << "<p><a href=\"" << escape(in.map_file) << "\">" << escape(in.map_file)
        << "</a>: " << in.map_vertices << " vertices";
   if (in.map_triangles > 0) html << ", " << in.map_triangles << " triangles";
-  html << "</p>\n<div class=\"row\">\n";
+  html << "</p>\n<div class=\"previews\">\n";
   for (const std::string& file : in.previews) html << image(file, file, "preview");
   return html.str() + "</div></section>\n";
 }

@@ -20,7 +20,8 @@ table.counts td { text-align: center; }
 img { border: 1px solid #ccc; background: #fff; display: block; }
 img.plot { max-width: 100%; width: 760px; margin-bottom: 12px; }
 img.wide { max-width: 100%; width: 1000px; }
-img.preview { width: 620px; max-width: 100%; }
+img.preview { width: 100%; }
+.previews { display: grid; grid-template-columns: 1fr 1fr; gap: 12px; }
 .status { padding: 2px 10px; border-radius: 10px; color: #fff; background: #777; font-weight: 600; }
 .status.complete { background: #2e7d32; }
 .status.interrupted { background: #ef6c00; }

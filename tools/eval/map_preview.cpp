@@ -198,9 +198,12 @@ void shade(const Buffers& buf, const MapPreviewOptions& options, cv::Mat3b* out)
 }
 
 /// Caption and, for orthographic views, a metric scale bar.
-void drawLabels(const PreviewCamera& cam, std::size_t points, cv::Mat3b* image) {
+void drawLabels(const PreviewCamera& cam, const PlyData& map, cv::Mat3b* image) {
   const cv::Scalar ink(235, 235, 235);
-  const std::string text = cam.name + " view, " + std::to_string(points) + " points";
+  const std::string text =
+      cam.name + " view, " +
+      (map.triangles.empty() ? std::to_string(map.vertices.size()) + " points"
+                             : std::to_string(map.triangles.size()) + " triangles");
   cv::putText(*image, text, {10, image->rows - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1,
               cv::LINE_AA);
   if (!cam.orthographic || cam.focal_px <= 0) return;
@@ -235,7 +238,7 @@ cv::Mat renderMapPreview(const PlyData& map, const PreviewCamera& camera,
   }
   cv::Mat3b image(options.height, options.width, options.background);
   shade(buf, options, &image);
-  if (options.labels) drawLabels(camera, map.vertices.size(), &image);
+  if (options.labels) drawLabels(camera, map, &image);
   return image;
 }
 

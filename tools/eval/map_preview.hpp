@@ -36,10 +36,11 @@ struct MapPreviewOptions {
   bool labels = true;                ///< caption and (orthographic views) a scale bar
 };
 
-/// World up direction of a scene: from the camera trajectory when given (image x axes are
-/// horizontal for a hand-held camera; the sign follows the mean image-up direction), snapped
-/// to the map's smallest principal axis when that is within 25 degrees; otherwise (no
-/// trajectory) the map's smallest principal axis.
+/// World up direction of a scene. With a camera trajectory: the direction normal to the image x
+/// axes (horizontal for a hand-held camera without roll), or, when the camera never turned, the
+/// mean image-up direction made normal to x; the sign follows the mean image-up direction.
+/// Without a trajectory: the smallest principal axis of the map (a floor or table normal; tall
+/// off-centre objects tilt it by a few degrees), largest component made positive.
 Eigen::Vector3f estimateUp(const std::vector<Eigen::Vector3f>& points_W,
                            const std::vector<TimedPose>& trajectory);
 

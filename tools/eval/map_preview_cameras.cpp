@@ -134,11 +134,7 @@ Eigen::Vector3f estimateUp(const std::vector<Eigen::Vector3f>& points_W,
   if (up.norm() < 1e-9) return pca_up;
   up.normalize();
   if (up.dot(image_up) < 0) up = -up;
-  Eigen::Vector3f result = up.cast<float>();
-  const float c = result.dot(pca_up);
-  if (std::abs(c) > std::cos(25.0f * kPi / 180.0f))
-    result = c > 0 ? pca_up : Eigen::Vector3f(-pca_up);
-  return result;
+  return up.cast<float>();
 }
 
 std::vector<PreviewCamera> choosePreviewCameras(const std::vector<Eigen::Vector3f>& points_W,
