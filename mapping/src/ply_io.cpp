@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -33,24 +34,28 @@ std::size_t typeSize(const std::string& t, const std::string& path) {
   throw MappingError(path + ": unknown PLY type '" + t + "'");
 }
 
-double readBinary(std::istream& in, const std::string& t, const std::string& path) {
-  char buf[8];
-  const std::size_t n = typeSize(t, path);
-  if (!in.read(buf, static_cast<std::streamsize>(n))) {
-    throw MappingError(path + ": truncated PLY data");
-  }
-  auto as = [&](auto v) {
-    std::memcpy(&v, buf, sizeof(v));
+// Decodes one little-endian scalar of PLY type t at p.
+double decode(const char* p, const std::string& t) {
+  auto as = [p](auto v) {
+    std::memcpy(&v, p, sizeof(v));
     return static_cast<double>(v);
   };
-  if (t == "char" || t == "int8") return as(std::int8_t{});
+  if (t == "float" || t == "float32") return as(float{});
   if (t == "uchar" || t == "uint8") return as(std::uint8_t{});
+  if (t == "char" || t == "int8") return as(std::int8_t{});
   if (t == "short" || t == "int16") return as(std::int16_t{});
   if (t == "ushort" || t == "uint16") return as(std::uint16_t{});
   if (t == "int" || t == "int32") return as(std::int32_t{});
   if (t == "uint" || t == "uint32") return as(std::uint32_t{});
-  if (t == "float" || t == "float32") return as(float{});
   return as(double{});
+}
+
+double readBinary(std::istream& in, const std::string& t, const std::string& path) {
+  char buf[8];
+  if (!in.read(buf, static_cast<std::streamsize>(typeSize(t, path)))) {
+    throw MappingError(path + ": truncated PLY data");
+  }
+  return decode(buf, t);
 }
 
 std::vector<Element> readHeader(std::istream& in, const std::string& path, bool* binary) {
@@ -95,6 +100,37 @@ std::vector<Element> readHeader(std::istream& in, const std::string& path, bool*
   throw MappingError(path + ": PLY header without end_header");
 }
 
+// Binary vertices without list properties: read the whole block, decode by byte offsets.
+bool readFixedVertices(std::istream& in, const Element& e, const std::string& path,
+                       const std::array<int, 6>& idx, PlyData* data) {
+  std::vector<std::size_t> offset(e.props.size());
+  std::size_t stride = 0;
+  for (std::size_t k = 0; k < e.props.size(); ++k) {
+    if (!e.props[k].count_type.empty()) return false;
+    offset[k] = stride;
+    stride += typeSize(e.props[k].type, path);
+  }
+  std::vector<char> block(stride * e.count);
+  if (!in.read(block.data(), static_cast<std::streamsize>(block.size()))) {
+    throw MappingError(path + ": truncated PLY data");
+  }
+  auto value = [&](const char* rec, int k) {
+    const auto ku = static_cast<std::size_t>(k);
+    return decode(rec + offset[ku], e.props[ku].type);
+  };
+  const bool colours = idx[3] >= 0 && idx[4] >= 0 && idx[5] >= 0;
+  for (std::size_t i = 0; i < e.count; ++i) {
+    const char* rec = block.data() + i * stride;
+    data->vertices.emplace_back(value(rec, idx[0]), value(rec, idx[1]), value(rec, idx[2]));
+    if (colours) {
+      data->colors.push_back({static_cast<std::uint8_t>(value(rec, idx[3])),
+                              static_cast<std::uint8_t>(value(rec, idx[4])),
+                              static_cast<std::uint8_t>(value(rec, idx[5]))});
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 PlyData readPly(const std::string& path, bool with_faces) {
@@ -122,6 +158,9 @@ PlyData readPly(const std::string& path, bool with_faces) {
     }
     const bool colours = is_vertex && ir >= 0 && ig >= 0 && ib >= 0;
     if (is_vertex) data.vertices.reserve(e.count);
+    if (binary && is_vertex && readFixedVertices(in, e, path, {ix, iy, iz, ir, ig, ib}, &data)) {
+      continue;
+    }
     std::vector<double> values(e.props.size());
     std::vector<double> list;
     for (std::size_t i = 0; i < e.count; ++i) {

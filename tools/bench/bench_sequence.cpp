@@ -34,6 +34,7 @@ std::vector<BenchFrame> loadBenchFrames(const std::string& dir, int every, int m
   const std::size_t step = static_cast<std::size_t>(std::max(1, every));
   for (std::size_t i = 0; i < seq.size(); i += step) {
     const SequenceEntry& e = seq.entries()[i];
+    if (e.depth_path.empty()) continue;  // no depth within the association window
     const auto pose = interpolatePose(gt, e.rgb_timestamp_s);
     if (!pose) continue;
     BenchFrame f;

@@ -13,6 +13,7 @@ namespace dynamap {
 namespace {
 
 constexpr std::uint32_t kLeafSize = 8;
+constexpr double kCoarseDiagonal = 1.7321 * ReferenceClouds::kCoarseVoxelM + 1e-4;
 
 // Runs fn(i) for i in [0, n) on two threads (the machines have 2 cores).
 template <typename Fn>
@@ -61,7 +62,10 @@ std::uint32_t PointIndex::build(std::uint32_t begin, std::uint32_t end) {
   return id;
 }
 
-void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float* best_sq) const {
+// Exact nearest neighbour with the distance from q to each visited cell tracked incrementally
+// (per-axis offsets), so that far queries prune whole subtrees.
+void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float cell_sq,
+                        Eigen::Vector3f& offsets, float* best_sq) const {
   const Node& n = nodes_[node];
   if (n.axis < 0) {
     for (std::uint32_t i = n.begin; i < n.end; ++i) {
@@ -72,15 +76,24 @@ void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float* bes
   const float diff = q[n.axis] - n.split;
   const std::uint32_t near = diff < 0 ? n.left : n.right;
   const std::uint32_t far = diff < 0 ? n.right : n.left;
-  search(near, q, best_sq);
-  if (diff * diff < *best_sq) search(far, q, best_sq);
+  search(near, q, cell_sq, offsets, best_sq);
+  const float old = offsets[n.axis];
+  const float far_sq = cell_sq - old * old + diff * diff;
+  if (far_sq < *best_sq) {
+    offsets[n.axis] = diff;
+    search(far, q, far_sq, offsets, best_sq);
+    offsets[n.axis] = old;
+  }
 }
 
-float PointIndex::nearestDistance(const Eigen::Vector3f& q) const {
+float PointIndex::nearestDistance(const Eigen::Vector3f& q, float max_distance) const {
   if (points_.empty()) return std::numeric_limits<float>::infinity();
-  float best = std::numeric_limits<float>::infinity();
-  search(0, q, &best);
-  return std::sqrt(best);
+  float best = std::isfinite(max_distance) ? max_distance * max_distance * 1.0001f
+                                           : std::numeric_limits<float>::infinity();
+  Eigen::Vector3f offsets = Eigen::Vector3f::Zero();
+  search(0, q, 0.0f, offsets, &best);
+  const float d = std::sqrt(best);
+  return d <= max_distance ? d : std::numeric_limits<float>::infinity();
 }
 
 std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& points,
@@ -118,6 +131,8 @@ ReferenceClouds loadReferenceClouds(const std::string& dir) {
   ReferenceClouds refs;
   refs.static_points = readPlyVertices((fs::path(dir) / "reference_static.ply").string());
   refs.static_ref = std::make_shared<PointIndex>(refs.static_points);
+  refs.static_coarse = std::make_shared<PointIndex>(
+      voxelCentroids(refs.static_points, ReferenceClouds::kCoarseVoxelM));
   const fs::path dyn = fs::path(dir) / "reference_dynamic.ply";
   if (fs::exists(dyn))
     refs.dynamic_ref = std::make_shared<PointIndex>(readPlyVertices(dyn.string()));
@@ -140,9 +155,19 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
   std::vector<float> d_static(map.size());
   std::vector<char> ghost(map.size(), 0);
   parallelFor(map.size(), [&](std::size_t i) {
-    d_static[i] = refs.static_ref->nearestDistance(map[i]);
+    d_static[i] = refs.static_ref->nearestDistance(map[i], thr);
+    if (!std::isfinite(d_static[i])) {
+      // Far from the scene: the coarse reference bounds the exact search (a centroid lies
+      // within one coarse voxel diagonal of a reference point).
+      const float bound = refs.static_coarse ? refs.static_coarse->nearestDistance(map[i]) +
+                                                   static_cast<float>(kCoarseDiagonal)
+                                             : std::numeric_limits<float>::infinity();
+      d_static[i] = options.exact_far_distances || !refs.static_coarse
+                        ? refs.static_ref->nearestDistance(map[i], bound)
+                        : std::max(bound - static_cast<float>(kCoarseDiagonal), thr * 1.0001f);
+    }
     if (d_static[i] > thr && refs.dynamic_ref) {
-      ghost[i] = refs.dynamic_ref->nearestDistance(map[i]) <= ghost_thr ? 1 : 0;
+      ghost[i] = refs.dynamic_ref->nearestDistance(map[i], ghost_thr) <= ghost_thr ? 1 : 0;
     }
   });
   double sum = 0.0;
@@ -155,10 +180,11 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
   m.accuracy_mean_m = sum / map.size();
   m.precision = static_cast<double>(close) / map.size();
   m.ghost_ratio = static_cast<double>(ghosts) / map.size();
+  if (!options.completeness) return m;
   const PointIndex map_index(map);
   std::vector<char> covered(refs.static_points.size(), 0);
   parallelFor(refs.static_points.size(), [&](std::size_t i) {
-    covered[i] = map_index.nearestDistance(refs.static_points[i]) <= thr ? 1 : 0;
+    covered[i] = map_index.nearestDistance(refs.static_points[i], thr) <= thr ? 1 : 0;
   });
   std::size_t n_covered = 0;
   for (const char c : covered) n_covered += c;

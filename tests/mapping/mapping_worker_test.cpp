@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include <condition_variable>
+#include <mutex>
+
+#include "mapping_test_utils.hpp"
+
+namespace dynamap::test {
+namespace {
+
+// Records what the worker hands it; integrate() blocks until released.
+struct FakeLog {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool released = false;
+  std::vector<std::uint64_t> integrated;
+  std::vector<std::size_t> points;
+  std::map<std::uint64_t, Eigen::Isometry3d> poses;
+  int resets = 0;
+};
+
+class FakeBackend final : public MapBackend {
+ public:
+  FakeBackend(FakeLog* log, PoseUpdateMode mode) : log_(log), mode_(mode) {}
+  void integrate(const KeyframeView& view) override {
+    std::unique_lock<std::mutex> lock(log_->mutex);
+    log_->cv.wait(lock, [&] { return log_->released; });
+    log_->integrated.push_back(view.id);
+    log_->points.push_back(view.points_C->size());
+    log_->poses[view.id] = view.T_W_C;
+  }
+  void updatePose(std::uint64_t id, const Eigen::Isometry3d& T_W_C) override {
+    std::lock_guard<std::mutex> lock(log_->mutex);
+    log_->poses[id] = T_W_C;
+  }
+  PoseUpdateMode poseUpdateMode() const override { return mode_; }
+  void reset() override { ++log_->resets; }
+  void exportMap(const std::string&) override {}
+  MapStats stats() const override { return {}; }
+
+ private:
+  FakeLog* log_;
+  PoseUpdateMode mode_;
+};
+
+KeyframePacketPtr packet(std::uint64_t id) {
+  const SyntheticFrame f = SyntheticScene().render(static_cast<int>(id % 6), 6);
+  auto kf = std::make_shared<KeyframePacket>();
+  kf->id = id;
+  kf->T_W_C = f.T_W_C;
+  kf->bgr = f.bgr;
+  kf->depth_m = f.depth_m;
+  kf->dynamic_mask = f.mask;
+  return kf;
+}
+
+TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
+  FakeLog log;
+  TimingRecorder timings;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), StaticPointsOptions{}, 1, &timings);
+  worker.push(packet(1));  // taken by the worker thread, which blocks in integrate()
+  // Wait until the worker took it, then fill the single queue slot.
+  for (int i = 0; i < 2000 && !worker.tryPush(packet(2)); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_FALSE(worker.tryPush(packet(3)));
+  EXPECT_GE(worker.droppedKeyframes(), 1u);
+  {
+    std::lock_guard<std::mutex> lock(log.mutex);
+    log.released = true;
+  }
+  log.cv.notify_all();
+  worker.finish();
+  EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{1, 2}));
+  EXPECT_EQ(timings.stats("mapping_integrate").count, 2u);
+  ASSERT_EQ(log.points.size(), 2u);
+  EXPECT_GT(log.points[0], 1000u);
+}
+
+TEST(MappingWorker, ForwardsPoseUpdatesIncludingEarlyOnes) {
+  FakeLog log;
+  log.released = true;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), StaticPointsOptions{}, 4, nullptr);
+  Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+  moved.translation() << 1, 2, 3;
+  worker.applyPoseUpdates({{7, moved}});  // before keyframe 7 exists
+  worker.push(packet(7));
+  worker.finish();
+  ASSERT_EQ(log.poses.count(7), 1u);
+  EXPECT_TRUE(log.poses.at(7).isApprox(moved));
+  EXPECT_EQ(log.resets, 0);
+}
+
+TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
+  for (const double dx : {0.001, 0.05}) {
+    FakeLog log;
+    log.released = true;
+    MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
+                         SyntheticScene::camera(), StaticPointsOptions{}, 4, nullptr);
+    std::vector<PoseUpdate> updates;
+    for (std::uint64_t id = 0; id < 3; ++id) {
+      const auto kf = packet(id);
+      worker.push(kf);
+      updates.push_back({id, Eigen::Translation3d(dx, 0, 0) * kf->T_W_C});
+    }
+    worker.applyPoseUpdates(updates);
+    worker.finish();
+    const bool rebuilt = dx > MappingWorker::kReintegrateTranslationM;
+    EXPECT_EQ(log.resets, rebuilt ? 1 : 0) << dx;
+    EXPECT_EQ(log.integrated.size(), rebuilt ? 6u : 3u) << dx;
+    EXPECT_EQ(worker.reintegratedKeyframes(), rebuilt ? 3u : 0u);
+    if (rebuilt) {
+      EXPECT_TRUE(log.poses.at(2).isApprox(updates[2].T_W_C));
+      EXPECT_EQ(log.points[3], log.points[0]);  // same static points from the stored depth
+    }
+  }
+}
+
+}  // namespace
+}  // namespace dynamap::test
