@@ -3,6 +3,8 @@
 #include <map>
 #include <string>
 
+#include "dynamap/mapping/static_points.hpp"
+
 namespace dynamap {
 
 /// Dense-mapping parameters, bound to YAML keys "mapping.<name>"
@@ -11,6 +13,9 @@ namespace dynamap {
 struct MappingConfig {
   std::string backend = "pcl_voxel";
   std::map<std::string, std::string> params;  ///< "<backend>.<key>" -> value
+  /// Depth + dynamic mask -> static points ("mapping.depth_min_m", "mapping.mask_dilation_px",
+  /// ...).
+  StaticPointsOptions static_points;
 };
 
 }  // namespace dynamap
