@@ -24,7 +24,8 @@ plugin::TsdfOptions readOptions(const BackendParams& params) {
   o.max_weight = static_cast<float>(reader.getDouble("max_weight", 100.0, 1.0, 1e6));
   o.min_weight = static_cast<float>(reader.getDouble("min_weight", 0.0, 0.0, 1e6));
   o.space_carving = reader.getBool("space_carving", true);
-  o.linear_weighting = reader.getString("weighting", "linear", {"constant", "linear"}) == "linear";
+  o.linear_weighting =
+      reader.getString("weighting", "constant", {"constant", "linear"}) == "linear";
   o.alloc_stride_px = reader.getInt("alloc_stride_px", 4, 1, 64);
   o.carve_stride_px = reader.getInt("carve_stride_px", 12, 1, 256);
   reader.finish();

@@ -203,7 +203,7 @@ int main(int argc, char** argv) {
   std::string plugin_dir = DYNAMAP_PLUGIN_BUILD_DIR;
   std::string out = "/tmp/dynamap_map_bench";
   int every = 1, max_frames = 0, stride = 2;
-  std::vector<std::string> only;
+  std::vector<std::string> only, sets;
   bool open3d = false, baselines = true, validate = false;
   app.add_option("--data", data, "sequence folder");
   app.add_option("--plugins", plugin_dir, "backend plugin folder");
@@ -212,6 +212,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-frames", max_frames, "0 = all");
   app.add_option("--stride", stride, "pixel stride of the static points");
   app.add_option("--only", only, "run only these labels");
+  app.add_option("--set", sets, "<label>.<key>=<value>: override a backend parameter of a run");
   app.add_flag("--open3d", open3d, "also run Open3D ScalableTSDFVolume (python3-open3d)");
   app.add_option("--baselines", baselines, "plain OctoMap and one-shot VoxelGrid baselines");
   app.add_flag("--validate", validate, "reproduce the README naive/masked metric rows and exit");
@@ -230,7 +231,7 @@ int main(int argc, char** argv) {
     std::printf("frames: %zu, static-point stride %d, plugins:", frames.size(), stride);
     for (const auto& n : registry.names()) std::printf(" %s", n.c_str());
     std::printf("\n");
-    const std::vector<RunSpec> specs = {
+    std::vector<RunSpec> specs = {
         {"points", "points", {{"keep_every", "2"}}, "cloud.ply"},
         {"pcl_voxel_1cm", "pcl_voxel", {{"voxel_size_m", "0.01"}}, "cloud.ply"},
         {"vdb_tsdf_1cm", "vdb_tsdf", {{"voxel_size_m", "0.01"}}, "mesh.ply"},
@@ -241,6 +242,18 @@ int main(int argc, char** argv) {
         "| run | accuracy (m) | precision | completeness | F-score | ghost | integrate "
         "median ms | p95 ms | map MB (own) | RSS growth MB | export ms |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const auto& set : sets) {
+      const auto dot = set.find('.');
+      const auto eq = set.find('=');
+      if (dot == std::string::npos || eq == std::string::npos || eq < dot) {
+        throw std::runtime_error("--set " + set + ": expected <label>.<key>=<value>");
+      }
+      for (auto& spec : specs) {
+        if (spec.label == set.substr(0, dot)) {
+          spec.params[set.substr(dot + 1, eq - dot - 1)] = set.substr(eq + 1);
+        }
+      }
+    }
     std::vector<RunResult> results;
     for (const auto& spec : specs) {
       if (!only.empty() && std::find(only.begin(), only.end(), spec.label) == only.end()) continue;
