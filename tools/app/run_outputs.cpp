@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "html_report.hpp"
 #include "image_io.hpp"
 #include "json_writer.hpp"
 #include "map_report.hpp"
@@ -125,6 +126,13 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
     writeTextFileAtomic(outPath(options, "metrics.json"), metrics_json + "\n");
   }
   writeRunJson(options.out_dir, result);
+  try {
+    report.warnings +=
+        writeHtmlReport(options.out_dir, fs::path(options.sequence_dir).filename().string(),
+                        sequence.groundTruthPath().value_or(""));
+  } catch (const std::exception& e) {
+    report.warnings += std::string("report skipped: ") + e.what() + "\n";
+  }
   return report;
 }
 
@@ -141,7 +149,8 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
     out << "keyframe masks vs ground truth: " << result.mask_scores.toJson() << "\n";
   }
   out << report.warnings;
-  out << "outputs in " << options.out_dir << " (map: " << result.map_dir << ")\n";
+  out << "outputs in " << options.out_dir << " (map: " << result.map_dir << "); report: "
+      << (fs::path(options.out_dir) / "report.html").string() << "\n";
 }
 
 }  // namespace dynamap
