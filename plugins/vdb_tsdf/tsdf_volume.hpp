@@ -20,7 +20,7 @@ struct TsdfOptions {
   float max_weight = 100.0f;
   float min_weight = 1.0f;       ///< export: every corner of a mesh cell needs this weight
   bool space_carving = true;     ///< visit existing blocks in front of the surface
-  bool linear_weighting = true;  ///< weight falls off linearly behind the surface
+  bool linear_weighting = false;  ///< weight falls off linearly behind the surface
   int alloc_stride_px = 4;       ///< pixel step when finding the blocks around the surface
   int carve_stride_px = 12;      ///< pixel step of the rays looking for stale blocks
 };
