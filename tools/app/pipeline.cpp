@@ -79,8 +79,9 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
   const auto registry = BackendRegistry::scan(pluginSearchPath());
   auto backend = registry.create(config_.mapping.backend,
                                  paramsForBackend(config_.mapping.params, config_.mapping.backend));
-  s.mapper = std::make_unique<MappingWorker>(std::move(backend), s.camera, StaticPointsOptions{},
-                                             kMappingQueueCapacity, &timings_);
+  s.mapper = std::make_unique<MappingWorker>(std::move(backend), s.camera,
+                                             config_.mapping.static_points, kMappingQueueCapacity,
+                                             &timings_);
 
   if (!options_.masks_dir.empty()) {
     if (!fs::is_directory(options_.masks_dir)) {
