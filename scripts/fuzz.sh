@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan) into build-fuzz and runs each one for
+# N seconds (default 10: the CI smoke run; e.g. 600 for a long run), one after another, niced.
+#   scripts/fuzz.sh [seconds-per-target]
+# Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-fuzz/fuzz/corpus/<target>/.
+# A crash leaves build-fuzz/fuzz/<target>-crash-* and makes the script fail; turn it into a
+# regression test (tests/io/fuzz_regression_test.cpp) before fixing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET=${1:-10}
+BUILD_DIR=${BUILD_DIR:-build-fuzz}
+if ! command -v clang++ >/dev/null 2>&1; then
+  echo "fuzz.sh: clang++ not found (apt-get install clang libclang-rt-dev)" >&2
+  exit 1
+fi
+GENERATOR=()
+if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
+cmake -S . -B "$BUILD_DIR" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=ON \
+  -DDYNAMAP_FUZZ_SECONDS="$SECONDS_PER_TARGET" >/dev/null
+nice -n 19 cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target dynamap_fuzzers
+cd "$BUILD_DIR"
+nice -n 19 ctest -L fuzz --output-on-failure -j1
