@@ -95,6 +95,20 @@ class DynSequence {
     return f;
   }
 
+  /// Ground-truth camera-to-world pose nearest to `stamp` (false if none within 0.02 s).
+  bool gtPose(double stamp, Eigen::Isometry3d* T_W_C) const {
+    if (poses_.empty()) return false;
+    const auto& p =
+        *std::min_element(poses_.begin(), poses_.end(), [&](const auto& a, const auto& b) {
+          return std::abs(a[0] - stamp) < std::abs(b[0] - stamp);
+        });
+    if (std::abs(p[0] - stamp) > 0.02) return false;
+    T_W_C->setIdentity();
+    T_W_C->linear() = Eigen::Quaterniond(p[7], p[4], p[5], p[6]).normalized().toRotationMatrix();
+    T_W_C->translation() = Eigen::Vector3d(p[1], p[2], p[3]);
+    return true;
+  }
+
  private:
   cv::Mat teddyMask(const cv::Mat& depth, double stamp, const cv::Mat& gt) const {
     const auto& p =

@@ -34,6 +34,18 @@ Eigen::Isometry3d LocalMap::keyframePose(std::uint64_t id) const {
   return keyframes_.at(id).T_W_C;
 }
 
+void LocalMap::markBad(const std::vector<std::uint64_t>& ids) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto id : ids) {
+    if (id < landmarks_.size()) landmarks_[id].bad = true;
+  }
+}
+
+bool LocalMap::isBad(std::uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return id < landmarks_.size() && landmarks_[id].bad;
+}
+
 void LocalMap::landmarkPositions(const std::vector<std::uint64_t>& ids,
                                  std::vector<Eigen::Vector3d>& out) const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -52,6 +64,7 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
   std::unordered_map<std::uint64_t, int> lm_index;
   for (int k = first_free; k < n; ++k) {
     for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
+      if (landmarks_[o.landmark_id].bad) continue;
       if (lm_index.emplace(o.landmark_id, static_cast<int>(w.landmark_ids.size())).second) {
         w.landmark_ids.push_back(o.landmark_id);
         w.points.push_back(landmarks_[o.landmark_id].p_W);
@@ -102,7 +115,7 @@ void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, c
     for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
       if (!seen.insert(o.landmark_id).second) continue;
       const Landmark& lm = landmarks_[o.landmark_id];
-      if (lm.descriptor.empty()) continue;
+      if (lm.descriptor.empty() || lm.bad) continue;
       ids.push_back(o.landmark_id);
       points.push_back(lm.p_W);
       descriptors.push_back(lm.descriptor);

@@ -1,5 +1,7 @@
 #include "dynamap/core/tracker.hpp"
 
+#include <algorithm>
+
 #include <opencv2/imgproc.hpp>
 
 #include "dynamap/core/tracking/tracker_impl.hpp"
@@ -42,6 +44,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     ScopedStageTimer timer(timings_, "lk");
     pyramid = lk_.buildPyramid(gray);
     matchFeatures(pyramid, T_W_C_pred, matches);
+    trackProbes(pyramid, matches);
   }
   TrackingResult result;
   const MotionFilterOutput filtered = runMotionFilter(frame, gray, matches);
@@ -89,6 +92,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   record(frame.timestamp_s, result.status, result.T_W_C);
   countStatus(result.status, result.is_keyframe);
   prev_pyramid_ = std::move(pyramid);
+  refillProbes(gray);
   // A grey input is used as is: copy it so the caller may reuse its buffer.
   prev_gray_ = gray.data == frame.bgr.data ? gray.clone() : gray;
   return result;
@@ -136,6 +140,58 @@ void Tracker::Impl::matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d&
   tracks_.swap(kept);
 }
 
+// Probes follow the flow of the frame (seeded by the median landmark flow) and are appended
+// after the landmark matches; they only inform the motion filter.
+void Tracker::Impl::trackProbes(const LkPyramid& cur, FeatureMatches& matches) {
+  if (!filter_ || probes_.empty() || prev_pyramid_.empty()) {
+    probes_.clear();
+    return;
+  }
+  cv::Point2f flow(0.f, 0.f);
+  if (!matches.cur_px.empty()) {
+    std::vector<float> dx, dy;
+    for (std::size_t i = 0; i < matches.cur_px.size(); ++i) {
+      dx.push_back(matches.cur_px[i].x - matches.prev_px[i].x);
+      dy.push_back(matches.cur_px[i].y - matches.prev_px[i].y);
+    }
+    const auto mid = static_cast<std::ptrdiff_t>(dx.size() / 2);
+    std::nth_element(dx.begin(), dx.begin() + mid, dx.end());
+    std::nth_element(dy.begin(), dy.begin() + mid, dy.end());
+    flow = cv::Point2f(dx[static_cast<std::size_t>(mid)], dy[static_cast<std::size_t>(mid)]);
+  }
+  std::vector<cv::Point2f> cur_px(probes_.size());
+  for (std::size_t i = 0; i < probes_.size(); ++i) cur_px[i] = probes_[i] + flow;
+  std::vector<std::uint8_t> ok;
+  lk_.track(prev_pyramid_, cur, probes_, cur_px, ok);
+  std::vector<cv::Point2f> kept;
+  kept.reserve(probes_.size());
+  for (std::size_t i = 0; i < probes_.size(); ++i) {
+    if (!ok[i]) continue;
+    matches.prev_px.push_back(probes_[i]);
+    matches.cur_px.push_back(cur_px[i]);
+    kept.push_back(cur_px[i]);
+  }
+  probes_.swap(kept);
+}
+
+// Tops the probes up from the current frame (which is the next frame's previous one).
+void Tracker::Impl::refillProbes(const cv::Mat& gray) {
+  const int wanted = filter_ ? config_.motion_probes : 0;
+  if (wanted <= 0) {
+    probes_.clear();
+    return;
+  }
+  if (static_cast<int>(probes_.size()) >= wanted * 7 / 10) return;
+  ScopedStageTimer timer(timings_, "probes");
+  const int spacing = std::max(1, config_.motion_probe_min_distance_px);
+  cv::Mat allowed(gray.size(), CV_8UC1, cv::Scalar(255));
+  for (const auto& p : probes_) cv::circle(allowed, p, spacing, cv::Scalar(0), -1);
+  std::vector<cv::Point2f> fresh;
+  cv::goodFeaturesToTrack(gray, fresh, wanted - static_cast<int>(probes_.size()), 0.01, spacing,
+                          allowed);
+  probes_.insert(probes_.end(), fresh.begin(), fresh.end());
+}
+
 MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
                                                   const FeatureMatches& matches) {
   if (!filter_) return {};
@@ -149,10 +205,13 @@ MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const 
 }
 
 int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out) {
-  const bool has_flags = out.match_is_dynamic.size() == matches.cur_px.size();
+  // The landmark tracks come first in `matches`, the motion probes after them.
+  const bool has_flags = out.match_is_dynamic.size() == matches.cur_px.size() &&
+                         out.match_is_dynamic.size() >= tracks_.size();
   const bool has_mask = !out.dynamic_mask.empty() && out.dynamic_mask.type() == CV_8UC1;
   if (!has_flags && !has_mask) return 0;
   int dropped = 0;
+  std::vector<std::uint64_t> bad;
   std::vector<FeatureTrack> kept;
   kept.reserve(tracks_.size());
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
@@ -165,11 +224,13 @@ int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilter
     }
     if (dynamic) {
       ++dropped;
+      bad.push_back(tracks_[i].landmark_id);
     } else {
       kept.push_back(tracks_[i]);
     }
   }
   tracks_.swap(kept);
+  map_.markBad(bad);  // a landmark on a moving object must not reach BA or relocalization
   return dropped;
 }
 

@@ -21,6 +21,13 @@ struct TrackerConfig {
   int lk_max_iterations = 20;       ///< LK iterations per level
   double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
 
+  // --- motion probes (only with a motion filter) ---
+  /// Extra LK points, not landmarks, appended to the matches handed to the motion filter so that
+  /// it sees the whole image every frame (landmark tracks alone vanish from a mover once they
+  /// are dropped, and a mover without tracks gets no mask). 0 = landmark tracks only.
+  int motion_probes = 500;
+  int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
+
   // --- depth ---
   double depth_min_m = 0.1;  ///< depth readings outside [min, max] are ignored
   double depth_max_m = 6.0;

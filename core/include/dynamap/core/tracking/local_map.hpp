@@ -16,6 +16,7 @@ namespace dynamap {
 struct Landmark {
   Eigen::Vector3d p_W;
   cv::Mat descriptor;  ///< 1 x 32 CV_8U
+  bool bad = false;    ///< seen on a moving object: never used again
 };
 
 struct KeyframeObservation {
@@ -56,6 +57,9 @@ class LocalMap {
                             std::vector<KeyframeObservation> observations);
   std::size_t keyframeCount() const;
   Eigen::Isometry3d keyframePose(std::uint64_t id) const;
+  /// Landmarks observed inside a dynamic region: left out of BA and relocalization from now on.
+  void markBad(const std::vector<std::uint64_t>& ids);
+  bool isBad(std::uint64_t id) const;
   /// out[i] = position of ids[i].
   void landmarkPositions(const std::vector<std::uint64_t>& ids,
                          std::vector<Eigen::Vector3d>& out) const;

@@ -50,6 +50,8 @@ class Tracker::Impl {
   Eigen::Isometry3d predictPose() const;
   void matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d& T_W_C_pred,
                      FeatureMatches& matches);
+  void trackProbes(const LkPyramid& cur, FeatureMatches& matches);
+  void refillProbes(const cv::Mat& gray);
   MotionFilterOutput runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
                                      const FeatureMatches& matches);
   int dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out);
@@ -74,6 +76,7 @@ class Tracker::Impl {
   LkPyramid prev_pyramid_;
   cv::Mat prev_gray_;
   std::vector<FeatureTrack> tracks_;  ///< parallel to the matches of the current frame
+  std::vector<cv::Point2f> probes_;   ///< motion probes in the previous frame (not landmarks)
   bool initialized_ = false;
   bool finished_ = false;
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
