@@ -20,6 +20,7 @@ RunScore run(const std::string& mode, int first, int count) {
   DynamicConfig c;
   c.mode = mode;
   resolveDynamicModelPaths(c, (test::sourceDir() / "config/default.yaml").string());
+  c.detector_async = false;  // every frame detected, as the bounds below were set
   DynamicMotionFilter filter(c, PinholeCamera{}, nullptr);
   const dynbench::DynSequence seq(test::sharedData() / "dynamic/teddy_dyn_dev");
   dynbench::SequenceFrame prev = seq.load(first);

@@ -32,6 +32,9 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.soft_nms_sigma", &c.soft_nms_sigma, 0.01, 10.0);
   schema.addDouble("dynamic.nms_dedup_iou", &c.nms_dedup_iou, 0.0, 1.0);
   schema.addInt("dynamic.detector_threads", &c.detector_threads, 0, 256);
+  schema.addBool("dynamic.detector_async", &c.detector_async);
+  schema.addInt("dynamic.detector_max_age_frames", &c.detector_max_age_frames, 0, 1000);
+  schema.addDouble("dynamic.stale_box_growth_px", &c.stale_box_growth_px, 0.0, 100.0);
 
   schema.addStringList("dynamic.high_dynamic_classes", &c.high_dynamic_classes);
   schema.addDouble("dynamic.high_dynamic_weight", &c.high_dynamic_weight, 0.0, 1.0);
@@ -44,6 +47,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.evidence_smoothing", &c.evidence_smoothing, 0.0, 0.99);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);
+  schema.addDouble("dynamic.static_carve_radius_px", &c.static_carve_radius_px, 0.0, 1000.0);
   schema.addDouble("dynamic.cluster_radius_px", &c.cluster_radius_px, 1.0, 1000.0);
   schema.addInt("dynamic.min_cluster_points", &c.min_cluster_points, 1, 100000);
   schema.addDouble("dynamic.flood_depth_step_m", &c.flood_depth_step_m, 0.001, 10.0);

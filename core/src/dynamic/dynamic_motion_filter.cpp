@@ -34,9 +34,16 @@ bool inMask(const cv::Mat& mask, const cv::Point2f& p) {
 
 }  // namespace
 
-/// Runs the detector on its own thread, one frame in flight.
+/// Runs the detector on its own thread, one frame in flight. Frames carry the filter's frame
+/// number so that results can be aged.
 class DynamicMotionFilter::Worker {
  public:
+  struct Result {
+    std::vector<Detection> detections;
+    long frame_no = -1;
+    double stamp = 0.0;
+  };
+
   Worker(std::unique_ptr<ObjectDetector> detector, int threads, DynamicMotionFilter* owner)
       : detector_(std::move(detector)),
         threads_(threads),
@@ -50,23 +57,26 @@ class DynamicMotionFilter::Worker {
     cv_.notify_all();
     thread_.join();
   }
-  void submit(const cv::Mat& bgr, double stamp) {
+  /// Hands the frame over if the thread is idle (or, with `wait`, once it is); false = skipped.
+  bool submit(const cv::Mat& bgr, long frame_no, double stamp, bool wait) {
     std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [&] { return !has_job_ && !busy_; });  // finish (and drop) the previous frame
+    if (wait) cv_.wait(lock, [&] { return !has_job_ && !busy_; });
+    if (has_job_ || busy_) return false;
     job_ = bgr.clone();
+    job_frame_ = frame_no;
     job_stamp_ = stamp;
     has_job_ = true;
-    has_result_ = false;
     cv_.notify_all();
+    return true;
   }
-  /// Detections of the frame with `stamp`, or std::nullopt-like false if none was submitted.
-  bool collect(double stamp, std::vector<Detection>* out) {
+  /// The newest finished result not yet taken (false if none); with `wait`, first waits for the
+  /// frame in flight. Rethrows a detector error.
+  bool take(Result* out, bool wait) {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (!has_job_ && !busy_ && !has_result_) return false;
-    cv_.wait(lock, [&] { return has_result_; });
+    if (wait) cv_.wait(lock, [&] { return !has_job_ && !busy_; });
+    if (!has_result_) return false;
     has_result_ = false;
     if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
-    if (result_stamp_ != stamp) return false;
     *out = std::move(result_);
     return true;
   }
@@ -88,22 +98,22 @@ class DynamicMotionFilter::Worker {
       cv_.wait(lock, [&] { return stop_ || has_job_; });
       if (stop_) return;
       cv::Mat job = std::move(job_);
-      const double stamp = job_stamp_;
+      Result result;
+      result.frame_no = job_frame_;
+      result.stamp = job_stamp_;
       has_job_ = false;
       busy_ = true;
       lock.unlock();
-      std::vector<Detection> dets;
       std::exception_ptr error;
       const auto start = Clock::now();
       try {
-        dets = detector_->detect(job);
+        result.detections = detector_->detect(job);
       } catch (...) {
         error = std::current_exception();
       }
       owner_->record("detector", msSince(start));
       lock.lock();
-      result_ = std::move(dets);
-      result_stamp_ = stamp;
+      result_ = std::move(result);
       error_ = error;
       busy_ = false;
       has_result_ = true;
@@ -117,9 +127,10 @@ class DynamicMotionFilter::Worker {
   std::mutex mutex_;
   std::condition_variable cv_;
   cv::Mat job_;
-  double job_stamp_ = 0.0, result_stamp_ = 0.0;
+  long job_frame_ = -1;
+  double job_stamp_ = 0.0;
   bool has_job_ = false, busy_ = false, has_result_ = false, stop_ = false;
-  std::vector<Detection> result_;
+  Result result_;
   std::exception_ptr error_;
   std::thread thread_;  // last: starts after every other member is ready
 };
@@ -164,16 +175,43 @@ void DynamicMotionFilter::record(const std::string& stage, double ms) {
 }
 
 void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
-  if (worker_ && !frame.bgr.empty()) worker_->submit(frame.bgr, frame.timestamp_s);
+  ++frame_no_;
+  begun_stamp_ = frame.timestamp_s;
+  if (!worker_ || frame.bgr.empty()) return;
+  const bool wait = !config_.detector_async;
+  if (!worker_->submit(frame.bgr, frame_no_, frame.timestamp_s, wait)) {
+    record("detector_skipped", 0.0);
+  }
 }
 
-std::vector<Detection> DynamicMotionFilter::waitDetections(const RgbdFrame* frame) {
+std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* frame) {
   if (!worker_ || frame == nullptr || frame->bgr.empty()) return {};
+  const bool begun = frame_no_ >= 0 && frame->timestamp_s == begun_stamp_;
   const auto start = Clock::now();
-  std::vector<Detection> dets;
-  const bool ok = worker_->collect(frame->timestamp_s, &dets);
+  Worker::Result fresh;
+  const bool sync = !config_.detector_async;
+  if (worker_->take(&fresh, sync)) {
+    latest_.detections = std::move(fresh.detections);
+    latest_.frame_no = fresh.frame_no;
+    latest_.stamp = fresh.stamp;
+    record("detector_fresh", 0.0);
+  }
   record("detector_wait", msSince(start));
-  return ok ? dets : worker_->runNow(frame->bgr);  // beginFrame() was not called for this frame
+  if (sync) {  // the frame's own detections (beginFrame() not called for it: detect now)
+    if (begun && latest_.frame_no == frame_no_) return latest_.detections;
+    return worker_->runNow(frame->bgr);
+  }
+  const long age = frame_no_ - latest_.frame_no;
+  if (latest_.frame_no < 0 || !begun || age > config_.detector_max_age_frames) return {};
+  record("detector_age", 1000.0 * (frame->timestamp_s - latest_.stamp));
+  // A walker moves a few pixels per frame: grow old boxes; fusion cuts them by depth again.
+  std::vector<Detection> dets = latest_.detections;
+  const auto grow = static_cast<float>(config_.stale_box_growth_px * static_cast<double>(age));
+  for (auto& d : dets) {
+    d.box =
+        cv::Rect2f(d.box.x - grow, d.box.y - grow, d.box.width + 2 * grow, d.box.height + 2 * grow);
+  }
+  return dets;
 }
 
 EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
@@ -211,7 +249,7 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   static const FeatureMatches kNoMatches;
   const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
-  auto dets = waitDetections(input.frame);
+  auto dets = currentDetections(input.frame);
   const cv::Mat frame_depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
 
   auto start = Clock::now();

@@ -81,6 +81,32 @@ cv::Rect clampRect(const cv::Rect2f& r, const cv::Size& size) {
          cv::Rect(cv::Point(0, 0), size);
 }
 
+/// Removes from `region` (inside `box`) the pixels that are nearer, by more than kCarveMarginPx,
+/// to a static tracked point inside the region than to a dynamic one, and within `radius` of it.
+constexpr float kCarveMarginPx = 4.f;
+void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Point2f>& points,
+                 const std::vector<std::uint8_t>& dyn, double radius) {
+  if (radius <= 0.0 || box.area() <= 0) return;
+  cv::Mat roi = region(box);
+  cv::Mat dyn_free(box.size(), CV_8UC1, cv::Scalar(255));
+  cv::Mat static_free(box.size(), CV_8UC1, cv::Scalar(255));
+  int n_dyn = 0, n_static = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const cv::Point p(cvRound(points[i].x) - box.x, cvRound(points[i].y) - box.y);
+    if (p.x < 0 || p.y < 0 || p.x >= box.width || p.y >= box.height) continue;
+    if (roi.at<uchar>(p) == 0) continue;
+    (dyn[i] ? dyn_free : static_free).at<uchar>(p) = 0;
+    ++(dyn[i] ? n_dyn : n_static);
+  }
+  if (n_dyn == 0 || n_static == 0) return;
+  cv::Mat d_dyn, d_static;
+  cv::distanceTransform(dyn_free, d_dyn, cv::DIST_L2, 3);
+  cv::distanceTransform(static_free, d_static, cv::DIST_L2, 3);
+  const cv::Mat remove =
+      (d_static + kCarveMarginPx < d_dyn) & (d_static < static_cast<float>(radius));
+  roi.setTo(0, remove);
+}
+
 }  // namespace
 
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
@@ -169,6 +195,9 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
       decideObject(d, next);
     }
     claimed |= region;
+    if (d.moving && mode == FusionMode::kBoth) {
+      carveStatic(region, box, points, dyn, config_.static_carve_radius_px);
+    }
     if (d.moving) result.mask |= region;
     result.objects.push_back(d);
   }

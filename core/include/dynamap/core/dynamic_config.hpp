@@ -49,7 +49,17 @@ struct DynamicConfig {
   double soft_nms_sigma = 0.5;
   double nms_dedup_iou = 0.7;  ///< recall NMS: duplicates above this IoU are dropped after soft-NMS
                                ///< ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
-  int detector_threads = 0;    ///< >0: cv::setNumThreads on first detection (process-wide)
+  /// >0: cv::setNumThreads on first detection (process-wide: OpenCV's pool is global). 1 by
+  /// default: on a 2-core machine the detector, tracker, BA and mapper threads already fill both
+  /// cores, and a second OpenCV worker per call only adds contention.
+  int detector_threads = 1;
+  /// true: beginFrame() hands the frame to the detector thread only when it is idle (other
+  /// frames are skipped, counted as "detector_skipped") and filter() never waits: it uses the
+  /// newest finished detections, their boxes grown by stale_box_growth_px per frame of age.
+  /// false: every frame is detected and filter() waits for its own detections.
+  bool detector_async = true;
+  int detector_max_age_frames = 6;   ///< older detections are not used (async)
+  double stale_box_growth_px = 6.0;  ///< per frame of age, on every side (async)
 
   // --- class table --------------------------------------------------------------------------
   /// COCO names of high-dynamic classes (can move by themselves).
@@ -63,12 +73,16 @@ struct DynamicConfig {
   std::map<std::string, std::string> class_weights{{"person", "1.0"}, {"chair", "0.5"}};
 
   // --- fusion -------------------------------------------------------------------------------
-  double moving_ratio = 0.7;         ///< weighted share of dynamic points to call an object moving
-  int min_object_points = 4;         ///< tracked points needed inside an object to decide
-  int min_dynamic_points = 3;        ///< dynamic points needed inside an object to call it moving
-  double evidence_smoothing = 0.6;   ///< weight of the past in the per-object motion evidence
-  double depth_band_m = 0.4;         ///< object pixels: within this of the object's depth mode
-  int mask_dilation_px = 7;          ///< final dilation of each region
+  double moving_ratio = 0.7;        ///< weighted share of dynamic points to call an object moving
+  int min_object_points = 4;        ///< tracked points needed inside an object to decide
+  int min_dynamic_points = 3;       ///< dynamic points needed inside an object to call it moving
+  double evidence_smoothing = 0.6;  ///< weight of the past in the per-object motion evidence
+  double depth_band_m = 0.4;        ///< object pixels: within this of the object's depth mode
+  int mask_dilation_px = 7;         ///< final dilation of each region
+  /// A moving object's pixels nearer (by more than 4 px) to a static tracked point inside it than
+  /// to any dynamic one, and within this radius of it, are not masked: a standing person next to
+  /// a walker at the same depth falls into the walker's depth cut. 0 = off.
+  double static_carve_radius_px = 24.0;
   double cluster_radius_px = 40;     ///< dynamic points closer than this form one cluster
   int min_cluster_points = 4;        ///< smaller clusters outside detections are noise
   double flood_depth_step_m = 0.03;  ///< depth continuity of the flood fill from clusters

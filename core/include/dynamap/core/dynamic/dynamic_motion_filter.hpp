@@ -30,8 +30,12 @@ struct MotionDiagnostics {
 };
 
 /// Motion-area removal: epipolar check + (optional) detector on a worker thread + fusion.
-/// Per-stage durations go to "detector" (on the worker), "epipolar", "fusion" and
-/// "detector_wait" (how long filter() blocked on the detector).
+/// Per-stage durations go to "detector" (on the worker, one entry per detection), "epipolar",
+/// "fusion" and "detector_wait" (how long filter() blocked on the detector). With
+/// detector_async (default) beginFrame() only hands a frame over when the detector is idle
+/// ("detector_skipped" counts the others), filter() uses the newest finished detections
+/// ("detector_fresh" counts frames where a new result arrived, "detector_age" records the age
+/// in ms of the detections used).
 /// beginFrame()/filter() are called from one (tracking) thread; not otherwise thread-safe.
 class DynamicMotionFilter : public MotionFilter {
  public:
@@ -54,7 +58,7 @@ class DynamicMotionFilter : public MotionFilter {
  private:
   class Worker;
   void record(const std::string& stage, double ms);
-  std::vector<Detection> waitDetections(const RgbdFrame* frame);
+  std::vector<Detection> currentDetections(const RgbdFrame* frame);
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets);
 
@@ -64,6 +68,14 @@ class DynamicMotionFilter : public MotionFilter {
   ClassTable classes_;
   RegionFusion fusion_;
   std::unique_ptr<Worker> worker_;  ///< null when no detector is used
+  struct LatestDetections {
+    std::vector<Detection> detections;
+    long frame_no = -1;  ///< frame number (beginFrame() count) they were computed on
+    double stamp = 0.0;
+  };
+  LatestDetections latest_;
+  long frame_no_ = -1;        ///< number of the frame given to the last beginFrame()
+  double begun_stamp_ = 0.0;  ///< its timestamp
   TimingRecorder* timing_;
   TimingRecorder own_timing_;
   MotionDiagnostics diagnostics_;
