@@ -82,6 +82,8 @@ void addRunCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--save-masks", options->save_masks, "write each keyframe's mask to OUT/masks/");
   cmd->add_flag("--debug-images", options->debug_images, "write debug pictures to OUT/debug/");
   cmd->add_flag("--quiet", options->quiet, "no progress line");
+  cmd->add_flag("--realtime", options->realtime,
+                "frames arrive at their own timestamps; stale work is skipped and counted");
   cmd->callback([options, exit_code] { *exit_code = runCommand(*options); });
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -36,6 +37,8 @@ struct Pipeline::Stages {
 namespace {
 
 constexpr std::size_t kMappingQueueCapacity = 16;
+constexpr double kMaxRealtimeLagS =
+    0.1;  ///< --realtime: skip a frame this late if a newer one waits
 
 std::string stampName(const std::string& rgb_path) { return fs::path(rgb_path).stem().string(); }
 
@@ -79,9 +82,9 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
   const auto registry = BackendRegistry::scan(pluginSearchPath());
   auto backend = registry.create(config_.mapping.backend,
                                  paramsForBackend(config_.mapping.params, config_.mapping.backend));
-  s.mapper = std::make_unique<MappingWorker>(std::move(backend), s.camera,
-                                             config_.mapping.static_points, kMappingQueueCapacity,
-                                             &timings_);
+  s.mapper =
+      std::make_unique<MappingWorker>(std::move(backend), s.camera, config_.mapping.static_points,
+                                      kMappingQueueCapacity, &timings_);
 
   if (!options_.masks_dir.empty()) {
     if (!fs::is_directory(options_.masks_dir)) {
@@ -105,6 +108,7 @@ Pipeline::~Pipeline() = default;
 RunResult Pipeline::run() {
   RunResult result;
   result.backend = config_.mapping.backend;
+  result.mode = options_.realtime ? "realtime" : "offline";
   const auto start = std::chrono::steady_clock::now();
   try {
     processFrames(result);
@@ -125,16 +129,44 @@ RunResult Pipeline::run() {
 }
 
 void Pipeline::processFrames(RunResult& result) {
+  using Clock = std::chrono::steady_clock;
   const std::size_t total = sequence_.size();
   ProgressLine progress(total, options_.quiet);
+  const auto& entries = sequence_.entries();
+  const Clock::time_point start = Clock::now();
+  const auto arrival = [&](std::size_t i) {  // --realtime: when frame i reaches us
+    const double offset_s = entries[i].rgb_timestamp_s - entries.front().rgb_timestamp_s;
+    return start +
+           std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s));
+  };
   for (std::size_t i = 0; i < total; ++i) {
     if (interruptRequested()) {
       result.status = "interrupted";
       std::fprintf(stderr, "\ninterrupted at frame %zu/%zu: writing what was computed\n", i, total);
       return;
     }
+    if (options_.realtime) {
+      std::this_thread::sleep_until(arrival(i));
+      const double lag_s = std::chrono::duration<double>(Clock::now() - arrival(i)).count();
+      if (lag_s > kMaxRealtimeLagS && i + 1 < total && Clock::now() >= arrival(i + 1)) {
+        ++result.counts.skipped_realtime;  // a newer frame is waiting: this one is stale
+        continue;
+      }
+    }
     processFrame(i, result);
+    if (options_.realtime) {
+      timings_.add("realtime_lag",
+                   std::chrono::duration<double, std::milli>(Clock::now() - arrival(i)).count());
+    }
     progress.update(i + 1);
+  }
+}
+
+void Pipeline::pushKeyframe(KeyframePacketPtr kf, RunResult& result) {
+  if (!options_.realtime) {
+    stages_->mapper->push(std::move(kf));
+  } else if (!stages_->mapper->tryPush(std::move(kf))) {
+    ++result.counts.mapper_dropped;
   }
 }
 
@@ -169,14 +201,14 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
     result.frame_status.push_back("given");
     result.keyframes.push_back({frame.timestamp_s, *pose});
     ++result.counts.keyframes;
-    s.mapper->push(kf);
+    pushKeyframe(kf, result);
     return;
   }
 
   if (s.given_masks) s.given_masks->setNextRgbPath(entry.rgb_path);
   const TrackingResult tracked = s.tracker->track(frame);
   if (tracked.is_keyframe && tracked.keyframe) {
-    s.mapper->push(tracked.keyframe);
+    pushKeyframe(tracked.keyframe, result);
     if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, tracked, result);
     if (options_.save_masks) writeKeyframeMask(entry, tracked);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);

@@ -25,6 +25,8 @@ struct RunCounts {
   std::size_t bad_frames = 0;
   std::size_t keyframes = 0;
   std::size_t mapped_keyframes = 0;
+  std::size_t skipped_realtime = 0;  ///< --realtime: frames skipped because tracking lagged
+  std::size_t mapper_dropped = 0;    ///< --realtime: keyframes the busy mapper did not take
 };
 
 /// What a run produced; filled even when it stops early.
@@ -37,6 +39,7 @@ struct RunResult {
   std::vector<TimedPose> keyframes;
   double wall_time_s = 0.0;
   std::string backend;
+  std::string mode = "offline";  ///< offline | realtime
   std::string map_dir;
   /// Keyframe masks vs the sequence's ground-truth masks (DIR/mask/), when it has them.
   MaskScoreSummary mask_scores;
@@ -62,6 +65,7 @@ class Pipeline {
   void processFrames(RunResult& result);
   void processFrame(std::size_t index, RunResult& result);
   void finalize(RunResult& result);
+  void pushKeyframe(KeyframePacketPtr kf, RunResult& result);
   void scoreKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked,
                          RunResult& result) const;
   void writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const;

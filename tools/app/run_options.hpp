@@ -16,6 +16,9 @@ struct RunOptions {
   bool save_masks = false;
   bool debug_images = false;
   bool quiet = false;
+  /// Frames arrive at the sequence's own timestamps (a live camera): when mapping falls
+  /// behind, keyframes are dropped (counted); when tracking lags, stale frames are skipped.
+  bool realtime = false;
 };
 
 }  // namespace dynamap

@@ -45,7 +45,8 @@ std::string timingsJson(const RunResult& result, const TimingRecorder& timings, 
   }
   const StageStats tracking = timings.stats("tracking");
   JsonObject root;
-  root.add("frames", static_cast<std::uint64_t>(result.counts.frames_read))
+  root.add("mode", result.mode)
+      .add("frames", static_cast<std::uint64_t>(result.counts.frames_read))
       .add("wall_time_s", result.wall_time_s)
       .add("frames_per_s", fps)
       .add("tracking_median_ms", tracking.median_ms)
@@ -73,9 +74,14 @@ void writeRunJson(const std::string& out_dir, const RunResult& result) {
       .add("lost", static_cast<std::uint64_t>(c.lost))
       .add("bad_frames", static_cast<std::uint64_t>(c.bad_frames))
       .add("keyframes", static_cast<std::uint64_t>(c.keyframes))
-      .add("mapped_keyframes", static_cast<std::uint64_t>(c.mapped_keyframes));
+      .add("mapped_keyframes", static_cast<std::uint64_t>(c.mapped_keyframes))
+      .add("skipped_realtime", static_cast<std::uint64_t>(c.skipped_realtime))
+      .add("mapper_dropped", static_cast<std::uint64_t>(c.mapper_dropped));
   JsonObject root;
-  root.add("status", result.status).add("counts", counts).add("backend", result.backend);
+  root.add("status", result.status)
+      .add("mode", result.mode)
+      .add("counts", counts)
+      .add("backend", result.backend);
   if (!result.error.empty()) root.add("error", result.error);
   fs::create_directories(out_dir);
   writeTextFileAtomic((fs::path(out_dir) / "run.json").string(), root.str(2) + "\n");
@@ -149,8 +155,8 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
     out << "keyframe masks vs ground truth: " << result.mask_scores.toJson() << "\n";
   }
   out << report.warnings;
-  out << "outputs in " << options.out_dir << " (map: " << result.map_dir << "); report: "
-      << (fs::path(options.out_dir) / "report.html").string() << "\n";
+  out << "outputs in " << options.out_dir << " (map: " << result.map_dir
+      << "); report: " << (fs::path(options.out_dir) / "report.html").string() << "\n";
 }
 
 }  // namespace dynamap
