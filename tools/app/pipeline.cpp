@@ -237,7 +237,12 @@ void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& fram
                                const TrackingResult& tracked) const {
   const fs::path dir = fs::path(options_.out_dir) / "debug";
   fs::create_directories(dir);
-  const cv::Mat picture = maskOverlay(frame.bgr, tracked.dynamic_mask);
+  // Features static/dynamic, detections and the mask, as the paper's figures show them.
+  const auto* computed = dynamic_cast<const DynamicMotionFilter*>(stages_->motion_filter.get());
+  const cv::Mat picture =
+      computed != nullptr
+          ? drawMotionDebug(frame.bgr, computed->lastDiagnostics(), computed->classTable())
+          : maskOverlay(frame.bgr, tracked.dynamic_mask);
   writeImageAtomic((dir / (stampName(entry.rgb_path) + ".jpg")).string(), picture);
 }
 
