@@ -16,17 +16,19 @@ namespace dynamap::fuzz {
 
 /// A folder of this process, removed at exit (left behind only after a crash).
 inline const std::string& scratchDir() {
-  static const std::string dir = [] {
+  // Never destroyed: the atexit cleanup runs after static destructors.
+  static const std::string* const dir = [] {
     namespace fs = std::filesystem;
     const fs::path d = fs::temp_directory_path() / ("dynamap_fuzz_" + std::to_string(::getpid()));
     fs::create_directories(d);
+    auto* path = new std::string(d.string());
     std::atexit([] {
       std::error_code ec;
       std::filesystem::remove_all(scratchDir(), ec);
     });
-    return d.string();
+    return path;
   }();
-  return dir;
+  return *dir;
 }
 
 /// Writes `bytes` to scratchDir()/name and returns the path.

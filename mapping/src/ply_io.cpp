@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -48,6 +49,22 @@ double decode(const char* p, const std::string& t) {
   if (t == "int" || t == "int32") return as(std::int32_t{});
   if (t == "uint" || t == "uint32") return as(std::uint32_t{});
   return as(double{});
+}
+
+// Bytes after the current read position (the most any element can still hold).
+std::uintmax_t remainingBytes(std::istream& in) {
+  const std::streampos here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streampos end = in.tellg();
+  in.seekg(here);
+  if (here < 0 || end < here) return 0;
+  return static_cast<std::uintmax_t>(end - here);
+}
+
+// A colour value of any PLY type as a byte (clamped; NaN -> 0).
+std::uint8_t toByte(double v) {
+  if (!(v > 0.0)) return 0;
+  return v < 255.0 ? static_cast<std::uint8_t>(v) : std::uint8_t{255};
 }
 
 double readBinary(std::istream& in, const std::string& t, const std::string& path) {
@@ -110,6 +127,9 @@ bool readFixedVertices(std::istream& in, const Element& e, const std::string& pa
     offset[k] = stride;
     stride += typeSize(e.props[k].type, path);
   }
+  if (stride == 0 || e.count > remainingBytes(in) / stride) {
+    throw MappingError(path + ": truncated PLY data");
+  }
   std::vector<char> block(stride * e.count);
   if (!in.read(block.data(), static_cast<std::streamsize>(block.size()))) {
     throw MappingError(path + ": truncated PLY data");
@@ -123,9 +143,8 @@ bool readFixedVertices(std::istream& in, const Element& e, const std::string& pa
     const char* rec = block.data() + i * stride;
     data->vertices.emplace_back(value(rec, idx[0]), value(rec, idx[1]), value(rec, idx[2]));
     if (colours) {
-      data->colors.push_back({static_cast<std::uint8_t>(value(rec, idx[3])),
-                              static_cast<std::uint8_t>(value(rec, idx[4])),
-                              static_cast<std::uint8_t>(value(rec, idx[5]))});
+      data->colors.push_back(
+          {toByte(value(rec, idx[3])), toByte(value(rec, idx[4])), toByte(value(rec, idx[5]))});
     }
   }
   return true;
@@ -157,6 +176,13 @@ PlyData readPly(const std::string& path, bool with_faces) {
       throw MappingError(path + ": PLY vertices without x, y, z");
     }
     const bool colours = is_vertex && ir >= 0 && ig >= 0 && ib >= 0;
+    if (e.props.empty()) continue;  // no data in the file
+    // Every element takes at least one byte: a larger count is a corrupt header.
+    const std::uintmax_t available = remainingBytes(in);
+    if (e.count > available) {
+      throw MappingError(path + ": PLY element '" + e.name + "' count " + std::to_string(e.count) +
+                         " exceeds the file size");
+    }
     if (is_vertex) data.vertices.reserve(e.count);
     if (binary && is_vertex && readFixedVertices(in, e, path, {ix, iy, iz, ir, ig, ib}, &data)) {
       continue;
@@ -180,6 +206,9 @@ PlyData readPly(const std::string& path, bool with_faces) {
         } else if (!(in >> n)) {
           throw MappingError(path + ": truncated PLY data");
         }
+        if (!(n >= 0.0 && n <= static_cast<double>(available))) {
+          throw MappingError(path + ": bad PLY list length " + std::to_string(n));
+        }
         list.resize(static_cast<std::size_t>(n));
         for (double& v : list) {
           if (binary) {
@@ -189,6 +218,11 @@ PlyData readPly(const std::string& path, bool with_faces) {
           }
         }
         if (is_face) {
+          for (const double v : list) {
+            if (!(v >= 0.0 && v < 4294967296.0)) {
+              throw MappingError(path + ": bad PLY face index " + std::to_string(v));
+            }
+          }
           for (std::size_t t = 1; t + 1 < list.size(); ++t) {  // fan-triangulate polygons
             data.triangles.push_back({static_cast<std::uint32_t>(list[0]),
                                       static_cast<std::uint32_t>(list[t]),
@@ -199,11 +233,16 @@ PlyData readPly(const std::string& path, bool with_faces) {
       if (is_vertex) {
         data.vertices.emplace_back(values[ix], values[iy], values[iz]);
         if (colours) {
-          data.colors.push_back({static_cast<std::uint8_t>(values[ir]),
-                                 static_cast<std::uint8_t>(values[ig]),
-                                 static_cast<std::uint8_t>(values[ib])});
+          data.colors.push_back({toByte(values[ir]), toByte(values[ig]), toByte(values[ib])});
         }
       }
+    }
+  }
+  for (const auto& t : data.triangles) {
+    if (t[0] >= data.vertices.size() || t[1] >= data.vertices.size() ||
+        t[2] >= data.vertices.size()) {
+      throw MappingError(path + ": PLY face index out of range (" +
+                         std::to_string(data.vertices.size()) + " vertices)");
     }
   }
   return data;

@@ -274,7 +274,8 @@ std::string timingsSection(const ReportInputs& in) {
   html << "<table class=\"stages\"><caption>Per stage</caption>\n<tr><th>stage</th><th>count</th>"
           "<th>median</th><th>p95</th><th>mean</th><th>max</th><th class=\"barcol\">"
           "median / p95</th></tr>\n";
-  for (const auto& [name, s] : stages->members()) {
+  for (const auto& [name, stage] : stages->members()) {
+    const JsonValue& s = stage;  // clang < 16 cannot capture structured bindings
     auto cell = [&](const char* key) {
       const JsonValue* v = s.find(key);
       return v ? format(key, *v) : std::string("n/a");

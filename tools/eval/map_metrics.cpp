@@ -108,8 +108,9 @@ std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& 
   for (const auto& p : points) {
     if (!p.allFinite()) continue;
     const auto k = [&](float v) {
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
-                                        (1 << 20)) &
+      // Clamped before the cast (a far point would overflow int64); keys wrap at 2^21 voxels.
+      const double cell = std::clamp(std::floor(v * inv), -1e15, 1e15);
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << 20)) &
              ((1u << 21) - 1);
     };
     Acc& a = voxels[k(p.x()) | (k(p.y()) << 21) | (k(p.z()) << 42)];

@@ -1,5 +1,6 @@
 #include "ply_colored.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -74,6 +75,7 @@ struct VertexLayout {
 
 bool vertexLayout(const Elem& e, VertexLayout* layout) {
   std::size_t offset = 0;
+  int xyz_size[3] = {0, 0, 0};
   const char* xyz_names[3] = {"x", "y", "z"};
   const char* rgb_names[3] = {"red", "green", "blue"};
   for (const Prop& p : e.props) {
@@ -85,12 +87,15 @@ bool vertexLayout(const Elem& e, VertexLayout* layout) {
           return false;
         layout->xyz[k] = static_cast<int>(offset);
         layout->xyz_double = size == 8;
+        xyz_size[k] = size;
       }
       if (p.name == rgb_names[k] && size == 1) layout->rgb[k] = static_cast<int>(offset);
     }
     offset += static_cast<std::size_t>(size);
   }
   layout->record = offset;
+  // Mixed float/double coordinates: the general reader.
+  if (xyz_size[0] != xyz_size[1] || xyz_size[1] != xyz_size[2]) return false;
   return layout->xyz[0] >= 0 && layout->xyz[1] >= 0 && layout->xyz[2] >= 0;
 }
 
@@ -140,6 +145,15 @@ PlyData readPlyForPreview(const std::string& path, std::size_t max_vertices,
     return subsample(std::move(data), max_vertices);
   }
   const std::size_t count = header.elements[0].count;
+  const std::streampos data_begin = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff data_bytes = in.tellg() - data_begin;
+  in.seekg(data_begin);
+  if (data_begin < 0 || data_bytes < 0 ||
+      count > static_cast<std::size_t>(data_bytes) / layout.record) {
+    throw std::runtime_error(path + ": truncated PLY data (" + std::to_string(count) +
+                             " vertices announced)");
+  }
   if (total_vertices) *total_vertices = count;
   const std::size_t stride =
       max_vertices > 0 && count > max_vertices ? (count + max_vertices - 1) / max_vertices : 1;

@@ -192,7 +192,11 @@ void ConfigSchema::loadYamlString(const std::string& text, const std::string& or
       }
     }
   };
-  walk(root, "");
+  try {
+    walk(root, "");
+  } catch (const YAML::Exception& e) {  // e.g. a key that is a map or a list
+    throw ConfigError(origin + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
 }
 
 void ConfigSchema::loadYamlFile(const std::string& path) {
