@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -158,6 +159,10 @@ PlyData readPly(const std::string& path, bool with_faces) {
   bool binary = false;
   const std::vector<Element> elements = readHeader(in, path, &binary);
   PlyData data;
+  if (std::count_if(elements.begin(), elements.end(),
+                    [](const Element& e) { return e.name == "vertex"; }) > 1) {
+    throw MappingError(path + ": PLY file with more than one vertex element");
+  }
   for (const Element& e : elements) {
     const bool is_vertex = e.name == "vertex";
     const bool is_face = e.name == "face" && with_faces;

@@ -137,6 +137,17 @@ TEST(FuzzRegression, PlyElementWithoutPropertiesIsSkipped) {
   EXPECT_FLOAT_EQ(data.vertices[0].z(), 3.0f);
 }
 
+// ply_fuzzer crash 58171a06: two vertex elements, one with colours and one without, gave
+// 4 colours for 8 vertices (readers index colours by vertex).
+TEST(FuzzRegression, PlyTwoVertexElementsAreAnError) {
+  std::string ply = kBinaryHeader +
+                    "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                    "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  ply += floatVertex(1, 2, 3) + floatVertex(4, 5, 6) + "abc";
+  EXPECT_THROW(readPly(writeFile("two_vertex.ply", ply)), MappingError);
+}
+
 // A map point at 1e30 m overflowed the int64 voxel key (UBSan float-cast-overflow).
 TEST(FuzzRegression, VoxelCentroidsOfFarPoints) {
   const std::vector<Eigen::Vector3f> points = {
