@@ -9,6 +9,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 WHAT=${1:-all}
+# clang and its sanitizer/libFuzzer runtimes (Debian: clang, libclang-rt-dev); other deps come
+# from scripts/install_deps.sh.
+if ! command -v clang++ >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    apt-get update -qq && apt-get install -y -qq --no-install-recommends clang libclang-rt-dev >/dev/null
+  else
+    echo "$(basename "$0"): needs clang and libclang-rt-dev (apt-get install clang libclang-rt-dev)" >&2
+    exit 1
+  fi
+fi
 GENERATOR=()
 if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
 CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo)
@@ -19,7 +29,7 @@ run_asan() {
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}"
   # detect_leaks: OpenCV/TBB/OpenVDB keep process-lifetime caches; leaks are checked too, with
   # the third-party ones listed in scripts/lsan.supp.
-  ASAN_OPTIONS=detect_stack_use_after_return=1:strict_string_checks=1:check_initialization_order=1 \
+  ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_order=1 \
   LSAN_OPTIONS=suppressions=$ROOT/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     nice -n 19 ctest --test-dir "$dir" -LE fuzz --output-on-failure -j1 ${CTEST_ARGS:-}

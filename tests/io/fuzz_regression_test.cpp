@@ -173,5 +173,26 @@ TEST(FuzzRegression, ConfigKeyThatIsNotAScalarIsAConfigError) {
   }
 }
 
+// config_fuzzer crash a7ae88c7: the effective config (written as config.yaml by every run)
+// did not load again: yaml-cpp wrote the value "b:\r" unquoted ("illegal map value").
+TEST(FuzzRegression, EffectiveConfigLoadsAgain) {
+  const std::vector<std::string> overrides = {
+      "mapping.params.points.a=b:\r",
+      "mapping.params.octomap.k\xc3\xa7=v:", "dynamic.high_dynamic_classes=person:,car\r",
+      "dynamic.model_cfg=/x\x01y"};
+  std::string effective;
+  const AppConfig config = loadAppConfig("", overrides, &effective);
+  ConfigSchema schema;
+  AppConfig again;
+  bindAppConfig(schema, again);
+  ASSERT_NO_THROW(schema.loadYamlString(effective, "effective")) << effective;
+  EXPECT_EQ(again.mapping.params, config.mapping.params);
+  EXPECT_EQ(again.dynamic.high_dynamic_classes, config.dynamic.high_dynamic_classes);
+  EXPECT_EQ(again.dynamic.model_cfg, config.dynamic.model_cfg);
+  // Bytes that are not UTF-8 come back as U+FFFD, but the file still loads.
+  loadAppConfig("", {"mapping.params.points.k\x8c\x8f=b:\r"}, &effective);
+  EXPECT_NO_THROW(schema.loadYamlString(effective, "effective")) << effective;
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -240,18 +240,30 @@ void insertPath(DumpTree& root, const std::string& key, const DumpTree& leaf) {
   node->is_list = leaf.is_list;
 }
 
+// yaml-cpp writes some plain scalars it cannot read back (e.g. "b:\r"): quote those.
+void emitScalar(YAML::Emitter& out, const std::string& s) {
+  bool quote = !s.empty() && s.back() == ':';
+  for (const unsigned char c : s) quote = quote || c < 0x20 || c == 0x7f;
+  if (quote) out << YAML::DoubleQuoted;
+  out << s;
+}
+
 void emitTree(YAML::Emitter& out, const DumpTree& node) {
   if (node.children.empty()) {
     if (node.is_list) {
-      out << YAML::Flow << node.list;
+      out << YAML::Flow << YAML::BeginSeq;
+      for (const auto& item : node.list) emitScalar(out, item);
+      out << YAML::EndSeq;
     } else {
-      out << node.scalar;
+      emitScalar(out, node.scalar);
     }
     return;
   }
   out << YAML::BeginMap;
   for (const auto& [name, child] : node.children) {
-    out << YAML::Key << name << YAML::Value;
+    out << YAML::Key;
+    emitScalar(out, name);
+    out << YAML::Value;
     emitTree(out, child);
   }
   out << YAML::EndMap;
@@ -279,6 +291,7 @@ std::string ConfigSchema::dumpYaml() const {
     }
   }
   YAML::Emitter out;
+  out.SetOutputCharset(YAML::EscapeNonAscii);  // invalid UTF-8 in a value stays loadable
   emitTree(out, root);
   return std::string(out.c_str()) + "\n";
 }
