@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   app.add_option("--mode", dc.mode, "off | geometry | detector | both");
   app.add_option("--detector", dc.detector, "detector kind or none");
   app.add_option("--ba", tc.bundle_adjustment, "bundle adjustment (true|false)");
+  app.add_option("--async", dc.detector_async, "dynamic.detector_async (true|false)");
   app.add_flag("--verbose", verbose, "one line per frame");
   CLI11_PARSE(app, argc, argv);
   resolveDynamicModelPaths(dc, (fs::path(DYNAMAP_SOURCE_DIR) / "config/default.yaml").string());
@@ -67,6 +68,18 @@ int main(int argc, char** argv) {
           i, toString(r.status), r.is_keyframe, c.matches, c.by_class[0], c.by_class[1],
           c.by_class[2], c.dynamic_by_class[0], c.dynamic_by_class[1], c.dynamic_by_class[2],
           c.same_pair ? "" : "PAIR! ", r.inliers, s.iou, s.standing_masked, s.teddy_masked, err);
+      if (const auto* dyn_filter = dynamic_cast<const DynamicMotionFilter*>(inner.get())) {
+        for (const auto& o : dyn_filter->lastDiagnostics().objects) {
+          const cv::Rect b = cv::Rect(o.detection.box) & cv::Rect(0, 0, 640, 480);
+          if (b.area() == 0 || o.detection.class_id != 0) continue;
+          std::printf(
+              "     person %.2f pts %d dyn %d moving %d depth %.2f | box standing %.2f "
+              "moving %.2f\n",
+              o.detection.score, o.points, o.dynamic_points, o.moving, o.depth_m,
+              cv::countNonZero(f.gt_mask(b) == 128) / double(b.area()),
+              cv::countNonZero(f.gt_mask(b) == 255) / double(b.area()));
+        }
+      }
     }
   }
   tracker.finish();

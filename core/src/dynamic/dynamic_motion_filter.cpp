@@ -264,7 +264,8 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
     depth = cv::Mat::zeros(size, CV_32FC1);
   }
-  FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets);
+  const bool informative = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
+  FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, informative);
   MotionFilterOutput out;
   out.match_is_dynamic.resize(m.cur_px.size(), 0);
   for (std::size_t i = 0; i < m.cur_px.size(); ++i) {

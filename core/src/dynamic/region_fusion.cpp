@@ -10,7 +10,9 @@ namespace dynamap {
 namespace {
 
 constexpr double kBinM = 0.1;
-constexpr int kBins = 100;  // 0..10 m
+constexpr int kStaticShareInverse = 10;  ///< < 1/10 of an object's points dynamic: static now
+constexpr int kStaticMinPoints = 12;     ///< ... with at least this many points
+constexpr int kBins = 100;               // 0..10 m
 
 /// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few.
 double depthMode(const cv::Mat& roi) {
@@ -140,7 +142,7 @@ RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classe
 
 void RegionFusion::decideObject(ObjectDecision& d, std::vector<Track>& next) {
   // Evidence: class prior x share of dynamic points on the object's own pixels.
-  const bool observed = d.points >= config_.min_object_points;
+  const bool observed = evidence_valid_ && d.points >= config_.min_object_points;
   const double evidence = observed ? d.weight * d.dynamic_points / d.points : 0.0;
   d.moving_now = observed && d.dynamic_points >= config_.min_dynamic_points &&
                  evidence >= config_.moving_ratio;
@@ -159,13 +161,22 @@ void RegionFusion::decideObject(ObjectDecision& d, std::vector<Track>& next) {
   const bool was_moving = prev != nullptr && prev->moving;
   d.moving = was_moving ? score >= 0.5 * config_.moving_ratio
                         : (d.moving_now && score >= config_.moving_ratio);
+  // Clear static evidence now counts twice (a faster release): boxes are associated by IoU,
+  // and a standing person next to a walker can inherit the walker's track. A single quiet
+  // frame still holds a moving object.
+  if (prev != nullptr && d.points >= kStaticMinPoints &&
+      d.dynamic_points * kStaticShareInverse < d.points) {
+    score = a * score + (1.0 - a) * evidence;
+    d.moving = was_moving && score >= 0.5 * config_.moving_ratio;
+  }
   next.push_back(Track{d.detection.box, d.detection.class_id, score, d.moving});
 }
 
 FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const std::vector<cv::Point2f>& points,
                                 const std::vector<std::uint8_t>& dyn,
-                                const std::vector<Detection>& detections) {
+                                const std::vector<Detection>& detections, bool evidence_valid) {
+  evidence_valid_ = evidence_valid;
   FusionResult result;
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
@@ -202,7 +213,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     result.objects.push_back(d);
   }
   tracks_ = std::move(next);
-  if (mode != FusionMode::kDetector) {
+  if (mode != FusionMode::kDetector && evidence_valid) {
     result.clusters = growClusters(depth_m, points, dyn, claimed, result.mask);
   }
   if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {
@@ -246,7 +257,10 @@ int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Poi
       cv::floodFill(depth_roi, flood, s, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
                     8 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
     }
-    cv::Mat filled = flood(cv::Rect(1, 1, roi.width, roi.height)) == 255;
+    cv::Mat filled = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+    filled(roi).setTo(255, flood(cv::Rect(1, 1, roi.width, roi.height)) == 255);
+    carveStatic(filled, roi, points, dyn, config_.static_carve_radius_px);
+    filled = filled(roi);
     if (cv::countNonZero(filled) == 0) {  // no depth: the hull of the points
       std::vector<cv::Point> hull;
       for (const auto& p : gp) hull.emplace_back(cvRound(p.x), cvRound(p.y));

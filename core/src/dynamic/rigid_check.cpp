@@ -46,14 +46,6 @@ bool beyondRange(const cv::Mat& depth_m, const cv::Point2f& p) {
   return true;
 }
 
-bool medianFlowBelow(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b,
-                     double px) {
-  std::vector<double> d(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) d[i] = cv::norm(a[i] - b[i]);
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2] < px;
-}
-
 struct PoseFit {
   cv::Mat rvec, tvec;
   std::vector<int> inliers;  ///< indices into the fit arrays
@@ -138,7 +130,8 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
   if (static_cast<int>(n) < std::max(o.min_matches, 8) || depth_m.empty()) {
     return depth_m.empty() ? checkEpipolar(prev_px, cur_px, o) : r;
   }
-  if (medianFlowBelow(prev_px, cur_px, o.min_parallax_px)) return r;
+  // No parallax guard here: with depth, a still camera is well-conditioned (PnP), and a walker
+  // seen from it is exactly what must be found.
 
   std::vector<cv::Point3f> X(n);
   std::vector<float> z(n);

@@ -9,6 +9,9 @@
 namespace dynamap {
 namespace {
 
+/// A dropped track farther than this many PnP thresholds from its landmark's projection moved.
+constexpr double kMovedLandmarkFactor = 2.0;
+
 cv::Mat toGray(const cv::Mat& image, const PinholeCamera& camera) {
   if (image.empty()) return cv::Mat::zeros(camera.height, camera.width, CV_8UC1);
   if (image.type() == CV_8UC1) return image;
@@ -79,6 +82,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
       result.keyframe = createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask);
     }
   }
+  if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);
+  dropped_.clear();
   if (result.status == FrameStatus::kLost) {
     result.T_W_C = T_W_last_;
     tracks_.clear();
@@ -211,7 +216,7 @@ int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilter
   const bool has_mask = !out.dynamic_mask.empty() && out.dynamic_mask.type() == CV_8UC1;
   if (!has_flags && !has_mask) return 0;
   int dropped = 0;
-  std::vector<std::uint64_t> bad;
+  dropped_.clear();
   std::vector<FeatureTrack> kept;
   kept.reserve(tracks_.size());
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
@@ -224,14 +229,36 @@ int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilter
     }
     if (dynamic) {
       ++dropped;
-      bad.push_back(tracks_[i].landmark_id);
+      dropped_.push_back(tracks_[i]);
     } else {
       kept.push_back(tracks_[i]);
     }
   }
   tracks_.swap(kept);
-  map_.markBad(bad);  // a landmark on a moving object must not reach BA or relocalization
   return dropped;
+}
+
+// A dropped track whose landmark no longer projects onto it with the frame's pose has moved:
+// its landmark must not reach BA or relocalization again. Static landmarks that a (too large)
+// mask covered still project onto their tracks and stay usable.
+void Tracker::Impl::cullMovedLandmarks(const Eigen::Isometry3d& T_W_C) {
+  if (dropped_.empty()) return;
+  std::vector<std::uint64_t> ids(dropped_.size()), bad;
+  for (std::size_t i = 0; i < dropped_.size(); ++i) ids[i] = dropped_[i].landmark_id;
+  std::vector<Eigen::Vector3d> p_W;
+  map_.landmarkPositions(ids, p_W);
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  const double max_px = kMovedLandmarkFactor * config_.pnp_reprojection_px;
+  for (std::size_t i = 0; i < dropped_.size(); ++i) {
+    const Eigen::Vector3d p_C = T_C_W * p_W[i];
+    const bool moved =
+        p_C.z() <= 0.05 ||
+        (camera_.project(p_C) - Eigen::Vector2d(dropped_[i].px.x, dropped_[i].px.y)).norm() >
+            max_px;
+    if (moved) bad.push_back(ids[i]);
+  }
+  map_.markBad(bad);
+  dropped_.clear();
 }
 
 // ---- public wrappers ----

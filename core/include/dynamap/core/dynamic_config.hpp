@@ -59,7 +59,7 @@ struct DynamicConfig {
   /// false: every frame is detected and filter() waits for its own detections.
   bool detector_async = true;
   int detector_max_age_frames = 6;   ///< older detections are not used (async)
-  double stale_box_growth_px = 6.0;  ///< per frame of age, on every side (async)
+  double stale_box_growth_px = 3.0;  ///< per frame of age, on every side (async)
 
   // --- class table --------------------------------------------------------------------------
   /// COCO names of high-dynamic classes (can move by themselves).
@@ -78,7 +78,7 @@ struct DynamicConfig {
   int min_dynamic_points = 3;       ///< dynamic points needed inside an object to call it moving
   double evidence_smoothing = 0.6;  ///< weight of the past in the per-object motion evidence
   double depth_band_m = 0.4;        ///< object pixels: within this of the object's depth mode
-  int mask_dilation_px = 7;         ///< final dilation of each region
+  int mask_dilation_px = 3;         ///< final dilation of each region (mapping dilates again)
   /// A moving object's pixels nearer (by more than 4 px) to a static tracked point inside it than
   /// to any dynamic one, and within this radius of it, are not masked: a standing person next to
   /// a walker at the same depth falls into the walker's depth cut. 0 = off.

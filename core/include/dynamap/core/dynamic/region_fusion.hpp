@@ -41,14 +41,16 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
                      double* depth_mode_m);
 
 /// Fuses dynamic points and detections into a motion mask, with per-object temporal hysteresis
-/// (objects are associated frame to frame by box IoU). Not thread-safe (one caller).
+/// (objects are associated frame to frame by box IoU). fuse() with `evidence_valid` = false (the
+/// point flags carry no information: degenerate geometric check): objects keep their state and
+/// no clusters are grown. Not thread-safe (one caller).
 class RegionFusion {
  public:
   RegionFusion(const DynamicConfig& config, const ClassTable& classes);
 
   FusionResult fuse(FusionMode mode, const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
                     const std::vector<std::uint8_t>& point_is_dynamic,
-                    const std::vector<Detection>& detections);
+                    const std::vector<Detection>& detections, bool evidence_valid = true);
 
  private:
   struct Track {
@@ -65,6 +67,7 @@ class RegionFusion {
   DynamicConfig config_;
   ClassTable classes_;
   std::vector<Track> tracks_;
+  bool evidence_valid_ = true;
 };
 
 }  // namespace dynamap

@@ -55,6 +55,7 @@ class Tracker::Impl {
   MotionFilterOutput runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
                                      const FeatureMatches& matches);
   int dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out);
+  void cullMovedLandmarks(const Eigen::Isometry3d& T_W_C);
   bool estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
   bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
                   Eigen::Isometry3d& T_W_C, int& inliers);
@@ -75,8 +76,9 @@ class Tracker::Impl {
 
   LkPyramid prev_pyramid_;
   cv::Mat prev_gray_;
-  std::vector<FeatureTrack> tracks_;  ///< parallel to the matches of the current frame
-  std::vector<cv::Point2f> probes_;   ///< motion probes in the previous frame (not landmarks)
+  std::vector<FeatureTrack> tracks_;   ///< parallel to the matches of the current frame
+  std::vector<FeatureTrack> dropped_;  ///< tracks the motion filter dropped this frame
+  std::vector<cv::Point2f> probes_;    ///< motion probes in the previous frame (not landmarks)
   bool initialized_ = false;
   bool finished_ = false;
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
