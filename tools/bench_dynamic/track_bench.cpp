@@ -69,6 +69,16 @@ int main(int argc, char** argv) {
           c.by_class[2], c.dynamic_by_class[0], c.dynamic_by_class[1], c.dynamic_by_class[2],
           c.same_pair ? "" : "PAIR! ", r.inliers, s.iou, s.standing_masked, s.teddy_masked, err);
       if (const auto* dyn_filter = dynamic_cast<const DynamicMotionFilter*>(inner.get())) {
+        const auto& dg = dyn_filter->lastDiagnostics();
+        std::vector<double> res[3];
+        for (std::size_t k = 0; k < dg.matches.cur_px.size() && k < dg.residual_px.size(); ++k) {
+          res[dynbench::gtClass(f.gt_mask, dg.matches.cur_px[k])].push_back(dg.residual_px[k]);
+        }
+        auto med = [](const std::vector<double>& v) {
+          return v.empty() ? -1.0 : percentile(v, 50);
+        };
+        std::printf("     model %d residual median moving %.1f standing %.1f scene %.1f\n",
+                    static_cast<int>(dg.model), med(res[0]), med(res[1]), med(res[2]));
         for (const auto& o : dyn_filter->lastDiagnostics().objects) {
           const cv::Rect b = cv::Rect(o.detection.box) & cv::Rect(0, 0, 640, 480);
           if (b.area() == 0 || o.detection.class_id != 0) continue;

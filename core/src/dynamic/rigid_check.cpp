@@ -46,6 +46,16 @@ bool beyondRange(const cv::Mat& depth_m, const cv::Point2f& p) {
   return true;
 }
 
+/// True if 90 % of the matches moved less than `px`: nothing moved in the image at all (a
+/// repeated frame); the flags would carry no information about movers.
+bool nothingMoved(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b, double px) {
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = cv::norm(a[i] - b[i]);
+  const auto k = static_cast<std::ptrdiff_t>(d.size() * 9 / 10);
+  std::nth_element(d.begin(), d.begin() + k, d.end());
+  return d[static_cast<std::size_t>(k)] < px;
+}
+
 struct PoseFit {
   cv::Mat rvec, tvec;
   std::vector<int> inliers;  ///< indices into the fit arrays
@@ -130,8 +140,9 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
   if (static_cast<int>(n) < std::max(o.min_matches, 8) || depth_m.empty()) {
     return depth_m.empty() ? checkEpipolar(prev_px, cur_px, o) : r;
   }
-  // No parallax guard here: with depth, a still camera is well-conditioned (PnP), and a walker
-  // seen from it is exactly what must be found.
+  // No median-parallax guard: with depth a still camera is well-conditioned (PnP), and a walker
+  // seen from it must be found. Only a repeated frame (nothing moved) says nothing (kNone).
+  if (nothingMoved(prev_px, cur_px, o.min_parallax_px)) return r;
 
   std::vector<cv::Point3f> X(n);
   std::vector<float> z(n);

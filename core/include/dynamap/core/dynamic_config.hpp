@@ -28,7 +28,7 @@ struct DynamicConfig {
   /// rigid: PnP with the current depth (reprojection error; epipolar distance to the pose's F
   /// for matches without depth); epipolar: fundamental matrix only (no depth).
   std::string geometric_check = "rigid";
-  double reprojection_threshold_px = 4.5;
+  double reprojection_threshold_px = 3.0;  // scene residuals ~0.5 px; slow walkers ~4 px
   /// rigid check, matches without depth: symmetric epipolar distance to the PnP pose's F
   double rigid_epipolar_threshold_px = 2.5;
   int bucket_px = 40;               ///< model fits use at most 2 matches per bucket_px cell
