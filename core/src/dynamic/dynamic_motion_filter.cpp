@@ -269,7 +269,10 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   MotionFilterOutput out;
   out.match_is_dynamic.resize(m.cur_px.size(), 0);
   for (std::size_t i = 0; i < m.cur_px.size(); ++i) {
-    out.match_is_dynamic[i] = (epi.is_dynamic[i] || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
+    // A lone flag on an object decided static (e.g. the teddy taken for a person, whose near
+    // points have larger residuals) is noise: the object-level decision wins.
+    const bool lone_flag = epi.is_dynamic[i] && !inMask(fused.static_objects, m.cur_px[i]);
+    out.match_is_dynamic[i] = (lone_flag || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
   }
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
   prev_mask_ = fused.mask;

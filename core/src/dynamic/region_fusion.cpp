@@ -179,6 +179,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
   evidence_valid_ = evidence_valid;
   FusionResult result;
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  result.static_objects = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
   std::vector<Track> next;
   for (const auto& det : detections) {
@@ -209,7 +210,11 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     if (d.moving && mode == FusionMode::kBoth) {
       carveStatic(region, box, points, dyn, config_.static_carve_radius_px);
     }
-    if (d.moving) result.mask |= region;
+    if (d.moving) {
+      result.mask |= region;
+    } else {
+      result.static_objects |= region;
+    }
     result.objects.push_back(d);
   }
   tracks_ = std::move(next);

@@ -29,7 +29,8 @@ struct ObjectDecision {
 };
 
 struct FusionResult {
-  cv::Mat mask;  ///< CV_8UC1, 255 = moving
+  cv::Mat mask;            ///< CV_8UC1, 255 = moving
+  cv::Mat static_objects;  ///< CV_8UC1, 255 = pixels of detected objects decided not moving
   std::vector<ObjectDecision> objects;
   int clusters = 0;  ///< dynamic-point clusters grown into regions outside objects
 };
