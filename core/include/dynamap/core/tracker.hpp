@@ -45,7 +45,12 @@ struct KeyframeInfo {
 /// thread and relocalization. The world frame is the camera frame of the first tracked frame.
 ///
 /// Per frame: LK (seeded by a constant-velocity prediction, forward-backward checked) moves the
-/// tracked features; the motion filter (if any) drops dynamic ones; PnP-RANSAC + Ceres refine
+/// tracked features; with a motion filter, TrackerConfig::motion_probes extra LK points (not
+/// landmarks) are appended to its matches so that it sees movers every frame; the filter's
+/// dynamic matches and every feature inside its mask are dropped (a dropped landmark that no
+/// longer projects onto its track with the frame's pose is marked bad: out of BA and
+/// relocalization); the motion filter's mask also keeps ORB/new landmarks off movers at
+/// keyframes. PnP-RANSAC + Ceres refine
 /// the pose (reprojection + depth residuals); if that fails, relocalization by ORB matching
 /// against recent keyframes' landmarks; otherwise kLost with the last known pose.
 /// Keyframe policy (TrackerConfig): a new keyframe when tracked features < min_tracked_features,
