@@ -5,8 +5,9 @@
 #         ThreadSanitizer, in build-tsan, with scripts/tsan.supp
 #   scripts/sanitize.sh [asan|tsan|all]   (default all)
 # Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, JOBS (compile jobs, default 2), CTEST_ARGS (extra).
-# Excluded under ASan (ASAN_EXCLUDE, default "Quickly$"): the speed tests
-# SyntheticScene.RendersQuickly and MapPreview.WritesThreePngsAndRenders1500kPointsQuickly assert
+# Excluded under ASan (ASAN_EXCLUDE): the speed tests
+# SyntheticScene.RendersQuickly, MapPreview.WritesThreePngsAndRenders1500kPointsQuickly and
+# TrackerWithMotionFilter.TeddyDynDevFirst60FramesWalkersStayOutOfPoseAndMap (< 60 s) assert
 # wall-clock limits that a 2-10x sanitizer slowdown breaks; their code still runs in other tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,10 +35,14 @@ run_asan() {
     dynamap_mapping_tests dynamap_cli_tests
   # detect_leaks: OpenCV/TBB/OpenVDB keep process-lifetime caches; leaks are checked too, with
   # the third-party ones listed in scripts/lsan.supp.
-  ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_order=1 \
+  # alloc_dealloc_mismatch=0: Debian's PCL is built as C++14, where Eigen gives PointCloud a
+  # class operator new/delete (malloc/free); our C++17 plugins use aligned global new, and
+  # shared_ptr<PointCloud> disposal resolves to libpcl's C++14 instantiation -> "operator new vs
+  # free" in pcl_voxel's exportMap. Benign with glibc; every other ASan check stays on.
+  ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_order=1:alloc_dealloc_mismatch=0 \
   LSAN_OPTIONS=suppressions=$ROOT/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    nice -n 19 ctest --test-dir "$dir" -LE fuzz -E "${ASAN_EXCLUDE:-Quickly\$}" \
+    nice -n 19 ctest --test-dir "$dir" -LE fuzz -E "${ASAN_EXCLUDE:-Quickly\$|WalkersStayOutOfPoseAndMap}" \
       --output-on-failure -j1 ${CTEST_ARGS:-}
 }
 
