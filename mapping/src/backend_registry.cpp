@@ -90,7 +90,10 @@ std::unique_ptr<MapBackend> BackendRegistry::create(const std::string& name,
                        "' (plugins found: " + (list.empty() ? std::string("none") : list) +
                        "; add folders with DYNAMAP_PLUGIN_PATH)");
   }
-  void* raw = dlopen(it->second.c_str(), RTLD_NOW | RTLD_LOCAL);
+  // RTLD_NODELETE: a plugin and its dependencies stay mapped until exit. Their static data must
+  // outlive dlclose (OctoMap registers tree prototypes in static initialisers; LeakSanitizer
+  // reported them as leaked once the plugin was unloaded).
+  void* raw = dlopen(it->second.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
   if (raw == nullptr) {
     throw MappingError("backend plugin " + it->second + ": dlopen failed: " + dlerror());
   }

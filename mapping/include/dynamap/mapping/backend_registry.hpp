@@ -11,8 +11,9 @@ namespace dynamap {
 
 /// Finds backend plugins (files named libdynamap_backend_<name>.so) in explicit folders plus the
 /// colon-separated folders of the environment variable DYNAMAP_PLUGIN_PATH, and creates backends
-/// by name. Plugins are dlopen()ed on create(); the library stays loaded while any backend object
-/// created from it lives. No static-initializer registration. Thread-safe after scan().
+/// by name. Plugins are dlopen()ed on create() and stay loaded until exit (RTLD_NODELETE), so
+/// their libraries' static data outlives every backend. No static-initializer registration.
+/// Thread-safe after scan().
 class BackendRegistry {
  public:
   static BackendRegistry scan(const std::vector<std::string>& plugin_dirs);
