@@ -2,6 +2,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
@@ -50,7 +51,8 @@ make(out + '/v8.onnx', v8, 84)
 class GeneratedOnnx : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = test::freshTempDir("dyn_onnx");
+    // One folder per process: ctest runs each test in its own process, in parallel.
+    dir_ = test::freshTempDir("dyn_onnx_" + std::to_string(::getpid()));
     if (!fs::exists("/usr/bin/python3")) return;
     std::ofstream(dir_ / "gen.py") << kGenerator;
     const std::string cmd = "/usr/bin/python3 " + (dir_ / "gen.py").string() + " " + dir_.string();
