@@ -9,6 +9,8 @@
 # SyntheticScene.RendersQuickly, MapPreview.WritesThreePngsAndRenders1500kPointsQuickly and
 # TrackerWithMotionFilter.TeddyDynDevFirst60FramesWalkersStayOutOfPoseAndMap (< 60 s) assert
 # wall-clock limits that a 2-10x sanitizer slowdown breaks; their code still runs in other tests.
+# Excluded under TSan (TSAN_EXCLUDE): RunCommand.RealtimeModeKeepsTrackingLagBounded (p95 lag
+# < 500 ms; 532 ms under TSan, no report). TSAN_TESTS selects the threaded tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -57,7 +59,7 @@ run_tsan() {
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
   nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|AllBackends/BackendContract|RunCommand|FaultInjection)\\.}" \
-      --output-on-failure -j1 ${CTEST_ARGS:-}
+      -E "${TSAN_EXCLUDE:-RealtimeModeKeepsTrackingLagBounded}" --output-on-failure -j1 ${CTEST_ARGS:-}
 }
 
 case "$WHAT" in
