@@ -15,6 +15,11 @@ function(dynamap_target_defaults target)
                                              -fno-sanitize-recover=undefined
                                              -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+    if(CMAKE_CXX_COMPILER_ID MATCHES "Clang" AND target STREQUAL "dynamap_backend_vdb_tsdf")
+      # TBB headers (OpenVDB's accessor registry): see scripts/ubsan_ignore.txt.
+      target_compile_options(${target} PRIVATE
+        -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/scripts/ubsan_ignore.txt)
+    endif()
   endif()
   if(DYNAMAP_TSAN)
     target_compile_options(${target} PRIVATE -fsanitize=thread -fno-omit-frame-pointer)

@@ -189,6 +189,12 @@ TEST(FuzzRegression, EffectiveConfigLoadsAgain) {
   EXPECT_EQ(again.mapping.params, config.mapping.params);
   EXPECT_EQ(again.dynamic.high_dynamic_classes, config.dynamic.high_dynamic_classes);
   EXPECT_EQ(again.dynamic.model_cfg, config.dynamic.model_cfg);
+  // config_fuzzer crash 6ee5f8be: a 300-byte key (1800 characters once escaped) was written
+  // as an implicit key, which YAML limits to 1024 characters.
+  const std::string long_key = "mapping.params.points." + std::string(300, '\xff') + "=1";
+  loadAppConfig("", {long_key, "mapping.params.points." + std::string(2000, 'k') + "=2"},
+                &effective);
+  EXPECT_NO_THROW(schema.loadYamlString(effective, "effective")) << effective;
   // Bytes that are not UTF-8 come back as U+FFFD, but the file still loads.
   loadAppConfig("", {"mapping.params.points.k\x8c\x8f=b:\r"}, &effective);
   EXPECT_NO_THROW(schema.loadYamlString(effective, "effective")) << effective;

@@ -261,6 +261,8 @@ void emitTree(YAML::Emitter& out, const DumpTree& node) {
   }
   out << YAML::BeginMap;
   for (const auto& [name, child] : node.children) {
+    // Implicit keys are limited to 1024 characters (escapes included): explicit "? key".
+    if (name.size() > 128) out << YAML::LongKey;
     out << YAML::Key;
     emitScalar(out, name);
     out << YAML::Value;
