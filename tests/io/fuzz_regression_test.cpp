@@ -200,5 +200,29 @@ TEST(FuzzRegression, EffectiveConfigLoadsAgain) {
   EXPECT_NO_THROW(schema.loadYamlString(effective, "effective")) << effective;
 }
 
+// config_fuzzer crash bf3d19ae: "mapping.params.points...." (hundreds of dots) nested unnamed
+// maps ~500 deep in the effective config, which yaml-cpp then failed to read ("bad file").
+// Such keys are now refused up front, naming the key.
+TEST(FuzzRegression, PluginParameterKeyWithEmptyPartsIsAConfigError) {
+  for (const std::string& bad : std::vector<std::string>{
+           "mapping.params.points" + std::string(400, '.') + "x=1", "mapping.params.points..x=1",
+           "mapping.params.points.x.=1", "mapping.params..x=1", "mapping.params.a.b.c.d.e=1"}) {
+    try {
+      loadAppConfig("", {bad}, nullptr);
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("mapping.params."), std::string::npos) << e.what();
+    }
+  }
+  const std::string yaml_path = writeFile("deep.yaml",
+                                          "mapping:\n  params:\n    points:\n      "
+                                          "a:\n        b:\n          c:\n"
+                                          "            d: 1\n");
+  EXPECT_THROW(loadAppConfig(yaml_path, {}, nullptr), ConfigError);
+  // Ordinary plugin parameters still work.
+  const AppConfig ok = loadAppConfig("", {"mapping.params.points.voxel_m=0.01"}, nullptr);
+  EXPECT_EQ(ok.mapping.params.at("points.voxel_m"), "0.01");
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -134,6 +134,30 @@ void ConfigSchema::addStringMap(const std::string& prefix,
   prefixes_[prefix] = field;
 }
 
+namespace {
+
+// Free-form keys below a prefix (plugin parameters) are "<backend>.<name>": no empty parts
+// ("a..b" would nest unnamed sections in the effective config) and at most kMaxSubKeyParts
+// levels (yaml-cpp cannot read back maps nested hundreds deep).
+constexpr int kMaxSubKeyParts = 4;
+
+void checkSubKey(const std::string& key, const std::string& sub, const std::string& at) {
+  int parts = 1;
+  bool empty_part = sub.empty() || sub.front() == '.' || sub.back() == '.';
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    if (sub[i] != '.') continue;
+    ++parts;
+    empty_part = empty_part || (i + 1 < sub.size() && sub[i + 1] == '.');
+  }
+  if (empty_part) throw ConfigError(at + ": key '" + key + "' has an empty part ('..')");
+  if (parts > kMaxSubKeyParts) {
+    throw ConfigError(at + ": key '" + key + "' is nested deeper than " +
+                      std::to_string(kMaxSubKeyParts) + " levels below its section");
+  }
+}
+
+}  // namespace
+
 void ConfigSchema::setValue(const std::string& key, const std::string& value,
                             const std::string& at) {
   auto it = entries_.find(key);
@@ -144,7 +168,9 @@ void ConfigSchema::setValue(const std::string& key, const std::string& value,
   for (auto& [prefix, map] : prefixes_) {
     if (key.size() > prefix.size() + 1 && key.compare(0, prefix.size(), prefix) == 0 &&
         key[prefix.size()] == '.') {
-      (*map)[key.substr(prefix.size() + 1)] = value;
+      const std::string sub = key.substr(prefix.size() + 1);
+      checkSubKey(key, sub, at);
+      (*map)[sub] = value;
       return;
     }
   }
