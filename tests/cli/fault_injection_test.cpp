@@ -120,6 +120,24 @@ TEST(FaultInjection, WeightsOfTheWrongFormatFailBeforeAnyFrame) {
   }
 }
 
+// OpenCV's Darknet reader does not check for short reads; the detector compares the file
+// size with the network's parameter count (core/src/dynamic/detector_nets.cpp).
+TEST(FaultInjection, TruncatedDarknetWeightsFailBeforeAnyFrame) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const fs::path dir = test::freshTempDir("fault_truncweights");
+  {
+    std::ifstream in(kYoloDir / "yolo-fastest-1.1-xl.weights", std::ios::binary);
+    std::vector<char> head(100000);
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    std::ofstream(dir / "trunc.weights", std::ios::binary).write(head.data(), in.gcount());
+  }
+  expectModelErrorBeforeFirstFrame(
+      "fault_truncweights_run",
+      {"dynamic.model_cfg=" + (kYoloDir / "yolo-fastest-1.1-xl.cfg").string(),
+       "dynamic.model_weights=" + (dir / "trunc.weights").string()},
+      (dir / "trunc.weights").string());
+}
+
 TEST(FaultInjection, AllZeroDepthFramesAreTrackedAndCounted) {
   DYNAMAP_REQUIRE_SHARED_DATA();
   constexpr std::size_t kFrames = 30;

@@ -188,6 +188,28 @@ TEST(Darknet, MissingOrWrongModelIsAnErrorNamingTheFile) {
   EXPECT_NE(constructionError(c).find("nanodet.onnx"), std::string::npos);
 }
 
+// OpenCV's Darknet reader accepts a short .weights file; the detector must not.
+TEST(Darknet, TruncatedWeightsAreAnErrorNamingTheFile) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const DynamicConfig good = darknetConfig();
+  const auto full = fs::file_size(good.model_weights);
+  std::vector<char> bytes(full);
+  std::ifstream(good.model_weights, std::ios::binary)
+      .read(bytes.data(), static_cast<std::streamsize>(full));
+  const fs::path dir = test::freshTempDir("dyn_trunc_weights");
+  // Cut in the middle, and by a single float at the end.
+  for (const std::size_t keep : {full / 2, full - 4}) {
+    const fs::path path = dir / ("cut" + std::to_string(keep) + ".weights");
+    std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(keep));
+    DynamicConfig c = good;
+    c.model_weights = path.string();
+    const std::string error = constructionError(c);
+    EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+    EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+  }
+  EXPECT_EQ(constructionError(good), "");
+}
+
 TEST(NanoDet, FindsThePersonInPersonJpg) {
   DYNAMAP_REQUIRE_SHARED_DATA();
   DynamicConfig c;

@@ -1,5 +1,7 @@
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
@@ -77,6 +79,7 @@ class DarknetDetector : public NetDetector {
     requireFile(o.model_weights, "Darknet weights");
     load([&] { return cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights); },
          o.model_cfg + " / " + o.model_weights);
+    checkWeightsSize(o.model_weights);
   }
 
  protected:
@@ -89,6 +92,31 @@ class DarknetDetector : public NetDetector {
       if (trailing2d(o).second != 5 + kNumClasses) return "expected N x 85 region outputs";
     }
     return outs.empty() ? "no outputs" : "";
+  }
+  /// OpenCV's Darknet reader does not check for short reads: a truncated .weights file loads
+  /// and leaves part of the network uninitialised. The file must hold the header and one float
+  /// per parameter of the convolution and batch-norm layers (Region layers' anchors come from
+  /// the cfg).
+  void checkWeightsSize(const std::string& path) {
+    std::uintmax_t params = 0;
+    for (const auto& name : net_.getLayerNames()) {
+      const auto layer = net_.getLayer(net_.getLayerId(name));
+      if (layer->type == "Region") continue;
+      for (const auto& b : layer->blobs) params += b.total();
+    }
+    std::ifstream in(path, std::ios::binary);
+    std::int32_t version[3] = {0, 0, 0};
+    in.read(reinterpret_cast<char*>(version), sizeof(version));
+    const bool long_seen =
+        version[0] * 10 + version[1] >= 2 && version[0] < 1000 && version[1] < 1000;
+    const std::uintmax_t expected = sizeof(version) + (long_seen ? 8 : 4) + 4 * params;
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || size < expected) {
+      throw DetectorError("detector: Darknet weights file " + path +
+                          " is truncated: " + std::to_string(ec ? 0 : size) +
+                          " bytes, the cfg needs " + std::to_string(expected));
+    }
   }
   std::vector<Detection> candidates(const cv::Mat& bgr) override {
     std::vector<Detection> all;
