@@ -1,8 +1,20 @@
 #!/usr/bin/env bash
-# README command 2: install what is missing, build, run the whole test suite.
+# README command 2: install what is missing, build, run the whole test suite:
+#   1. the unit, integration and fault tests (ctest, Release build);
+#   2. a smoke fuzz run: every libFuzzer target for FUZZ_SECONDS (default 10) seconds from the
+#      seeded corpus in fuzz/corpus (clang, ASan + UBSan; scripts/fuzz.sh);
+#   3. the sanitizer runs (scripts/sanitize.sh): SANITIZERS="tsan asan" by default, i.e. the
+#      threaded tests under ThreadSanitizer and the whole suite under ASan + UBSan.
+# CI (.ci/run) runs exactly this. Locally, SANITIZERS= (empty) and FUZZ_SECONDS=0 skip 2 and 3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
-cd "${BUILD_DIR:-build}"
-ctest --output-on-failure -j"${JOBS:-2}" --timeout 900
+(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"${JOBS:-2}" --timeout 900)
+if [ "${FUZZ_SECONDS:-10}" != 0 ]; then
+  bash scripts/fuzz.sh "${FUZZ_SECONDS:-10}"
+fi
+for s in ${SANITIZERS-tsan asan}; do
+  bash scripts/sanitize.sh "$s"
+done
+echo "test.sh: all passed"
