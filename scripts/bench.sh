@@ -3,7 +3,7 @@
 # without motion-area removal, the removal ablations, every mapping backend from ground-truth
 # poses and masks) and the mapping component benchmark, then writes the generated section of
 # BENCHMARKS.md (machine, date, command, tables). Offline mode: every frame, as fast as possible.
-# usage: scripts/bench.sh            (about 10-15 minutes on 2 cores)
+# usage: [REPEATS=3] scripts/bench.sh   (about 10-15 minutes on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh >/dev/null
@@ -25,6 +25,12 @@ TSDF=(--set mapping.backend=vdb_tsdf --set mapping.params.vdb_tsdf.voxel_size_m=
 for mode in off both; do run "teddy__$mode" "$TEDDY" --set dynamic.mode=$mode "${TSDF[@]}"; done
 for mode in off geometry detector both; do
   run "teddy_dyn_dev__$mode" "$DYN" --set dynamic.mode=$mode "${TSDF[@]}"
+done
+# Tracking runs differ from run to run (bundle adjustment and the detector run on their own
+# threads): REPEATS runs of the ATE comparisons, summarised as median and range.
+for i in $(seq 2 "${REPEATS:-3}"); do
+  for mode in off both; do run "teddy__${mode}_r$i" "$TEDDY" --set dynamic.mode=$mode "${TSDF[@]}"; done
+  run "teddy_dyn_dev__both_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}"
 done
 for backend in points pcl_voxel vdb_tsdf octomap; do
   run "teddy_dyn_dev__gt-poses-masks_$backend" "$DYN" --poses "$DYN/groundtruth.txt" \

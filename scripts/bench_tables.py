@@ -7,6 +7,8 @@ Usage: bench_tables.py RUNS_DIR   (each sub-folder is one `dynamap run --out` fo
 import json
 import math
 import os
+import re
+import statistics
 import sys
 
 
@@ -61,6 +63,32 @@ def main(runs_dir):
               f"| {fmt(x['track_ms'], 1, 1)} / {fmt(x['track_p95'], 1, 1)} | {fmt(x['det_ms'], 1, 1)} "
               f"| {fmt(x['map_ms'], 1, 1)} | {fmt(x['prec'])} / {fmt(x['comp'])} / {fmt(x['ghost'], 1, 4)} "
               f"| {fmt(x['mem'], 1, 0)} |")
+    repeats(rows)
+
+
+def repeats(rows):
+    """Median and range of ATE (and mask IoU) over a run and its repeats (<label>_r<i>)."""
+    groups = {}
+    for x in rows:
+        m = re.match(r"^(.*)_r\d+$", x["label"])
+        key = (x["seq"], m.group(1) if m else x["label"])
+        groups.setdefault(key, []).append(x)
+    groups = {k: v for k, v in groups.items() if len(v) > 1}
+    if not groups:
+        return
+    print()
+    print("Repeated runs (same command; threads make runs differ):")
+    print()
+    print("| sequence | run | runs | ATE RMSE cm median (min–max) | mask IoU median | standing masked median |")
+    print("|---|---|---|---|---|---|")
+    for (seq, label), xs in sorted(groups.items()):
+        ate = [x["ate_cm"] for x in xs if x["ate_cm"] is not None]
+        iou = [x["iou"] for x in xs if x["iou"] is not None]
+        st = [x["standing"] for x in xs if x["standing"] is not None]
+        med = lambda v, s, d: fmt(statistics.median(v), s, d) if v else "–"
+        rng = f"({fmt(min(ate), 100, 2)}–{fmt(max(ate), 100, 2)})" if ate else ""
+        print(f"| {seq} | {label} | {len(xs)} | {med(ate, 100, 2)} {rng} | {med(iou, 1, 3)} "
+              f"| {med(st, 100, 1)} % |")
 
 
 if __name__ == "__main__":
