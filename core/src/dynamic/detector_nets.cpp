@@ -45,13 +45,16 @@ class NetDetector : public ObjectDetector {
 
  protected:
   explicit NetDetector(DetectorOptions options) : options_(std::move(options)) {}
-  void load(const std::function<cv::dnn::Net()>& reader, const std::string& file) {
+  /// Reads the net, runs `check` on it (may throw), then probes it with a grey image.
+  void load(const std::function<cv::dnn::Net()>& reader, const std::string& file,
+            const std::function<void()>& check = {}) {
     try {
       net_ = reader();
     } catch (const cv::Exception& e) {
       throw DetectorError("detector: cannot read model " + file + ": " + e.what());
     }
     if (net_.empty()) throw DetectorError("detector: cannot read model " + file);
+    if (check) check();
     net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
     net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
     try {
@@ -77,9 +80,9 @@ class DarknetDetector : public NetDetector {
   explicit DarknetDetector(const DetectorOptions& o) : NetDetector(o) {
     requireFile(o.model_cfg, "Darknet cfg");
     requireFile(o.model_weights, "Darknet weights");
+    // The size check comes before the probe: a net with uninitialised weights is never run.
     load([&] { return cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights); },
-         o.model_cfg + " / " + o.model_weights);
-    checkWeightsSize(o.model_weights);
+         o.model_cfg + " / " + o.model_weights, [&] { checkWeightsSize(o.model_weights); });
   }
 
  protected:
