@@ -1,5 +1,6 @@
 #include "dynamap/mapping/mapping_worker.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -81,12 +82,48 @@ void MappingWorker::run() {
         queue_.pop_front();
       }
       updates.swap(pending_updates_);
-      if (!kf && updates.empty() && stopping_) return;
+      if (!kf && updates.empty() && stopping_) break;
     }
     not_full_.notify_all();
     std::lock_guard<std::mutex> lock(backend_mutex_);
-    if (kf) integratePacket(*kf);
+    if (kf) advanceWindow(std::move(kf), false);
     for (const auto& u : updates) applyUpdateLocked(u);
+  }
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  advanceWindow(nullptr, true);
+}
+
+void MappingWorker::advanceWindow(KeyframePacketPtr kf, bool flush) {
+  const FreeSpaceOptions& fs = options_.free_space;
+  const std::size_t n = fs.enabled ? static_cast<std::size_t>(std::max(0, fs.neighbours)) : 0;
+  if (kf) {
+    WindowEntry e;
+    if (n > 0) e.view = makeFreeSpaceView(kf->depth_m, kf->T_W_C);
+    e.kf = std::move(kf);
+    window_.push_back(std::move(e));
+  }
+  for (std::size_t i = 0; i < window_.size(); ++i) {
+    if (window_[i].integrated) continue;
+    if (!flush && window_.size() - i - 1 < n) break;  // wait for the later neighbours
+    cv::Mat flagged;
+    if (n > 0) {
+      ScopedStageTimer timer(timings_, "mapping_free_space");
+      std::vector<const FreeSpaceView*> others;
+      for (std::size_t j = (i > n ? i - n : 0); j < std::min(window_.size(), i + n + 1); ++j) {
+        if (j != i) others.push_back(&window_[j].view);
+      }
+      const KeyframePacket& k = *window_[i].kf;
+      flagged = freeSpaceViolations(camera_, k.depth_m, k.T_W_C, others, fs);
+    }
+    integratePacket(*window_[i].kf, flagged);
+    window_[i].integrated = true;
+  }
+  // Keep the n integrated keyframes before the first waiting one.
+  std::size_t integrated = 0;
+  while (integrated < window_.size() && window_[integrated].integrated) ++integrated;
+  while (integrated > n) {
+    window_.pop_front();
+    --integrated;
   }
 }
 
@@ -100,9 +137,13 @@ void MappingWorker::applyUpdateLocked(const PoseUpdate& update) {
   backend_->updatePose(update.keyframe_id, update.T_W_C);
 }
 
-void MappingWorker::integratePacket(const KeyframePacket& kf) {
+void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask) {
   ScopedStageTimer timer(timings_, "mapping_integrate");
-  StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, kf.dynamic_mask, options_);
+  cv::Mat mask = kf.dynamic_mask;
+  if (!extra_mask.empty() && cv::countNonZero(extra_mask) > 0) {
+    mask = mask.empty() ? extra_mask : cv::max(mask, extra_mask);
+  }
+  StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, mask, options_);
   KeyframeView view;
   view.id = kf.id;
   view.timestamp_s = kf.timestamp_s;

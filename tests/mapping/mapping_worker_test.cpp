@@ -57,8 +57,10 @@ KeyframePacketPtr packet(std::uint64_t id) {
 TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   FakeLog log;
   TimingRecorder timings;
+  StaticPointsOptions options;
+  options.free_space.enabled = false;  // integrate on arrival (no neighbour window)
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
-                       SyntheticScene::camera(), StaticPointsOptions{}, 1, &timings);
+                       SyntheticScene::camera(), options, 1, &timings);
   worker.push(packet(1));  // taken by the worker thread, which blocks in integrate()
   // Wait until the worker took it, then fill the single queue slot.
   for (int i = 0; i < 2000 && !worker.tryPush(packet(2)); ++i) {
@@ -76,6 +78,24 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   EXPECT_EQ(timings.stats("mapping_integrate").count, 2u);
   ASSERT_EQ(log.points.size(), 2u);
   EXPECT_GT(log.points[0], 1000u);
+}
+
+TEST(MappingWorker, FreeSpaceWindowIntegratesEveryKeyframeInOrderByFinish) {
+  FakeLog log;
+  log.released = true;
+  TimingRecorder timings;
+  StaticPointsOptions options;
+  options.free_space.enabled = true;
+  options.free_space.neighbours = 2;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), options, 8, &timings);
+  for (std::uint64_t id = 1; id <= 5; ++id) worker.push(packet(id));
+  worker.finish();  // the last two wait for later neighbours until the flush
+  EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(timings.stats("mapping_free_space").count, 5u);
+  ASSERT_EQ(log.points.size(), 5u);
+  // A static synthetic scene: the check removes (almost) nothing.
+  for (const std::size_t n : log.points) EXPECT_GT(n, 1000u);
 }
 
 TEST(MappingWorker, ForwardsPoseUpdatesIncludingEarlyOnes) {

@@ -22,7 +22,10 @@ namespace dynamap {
 /// from bundle adjustment are forwarded to the backend; volumetric backends (kReintegrate) are
 /// rebuilt with the final poses in finish() when some keyframe moved by more than
 /// `kReintegrateTranslationM` / `kReintegrateRotationRad`. For that the worker keeps each
-/// keyframe's static depth (16-bit, 0.2 mm) and colour. All public methods are thread-safe;
+/// keyframe's static depth (16-bit, 0.2 mm) and colour. With options.free_space enabled, a
+/// keyframe is integrated once its `neighbours` later keyframes have arrived (or at finish()),
+/// without the pixels that lie in free space seen by up to `neighbours` keyframes on each side
+/// (freeSpaceViolations(): movers the masks missed). All public methods are thread-safe;
 /// exportMap() and stats() after finish() see the final map.
 class MappingWorker {
  public:
@@ -57,8 +60,16 @@ class MappingWorker {
     cv::Mat depth_u16;  ///< static depth, 1/5000 m
     cv::Mat bgr;
   };
+  struct WindowEntry {
+    KeyframePacketPtr kf;
+    FreeSpaceView view;
+    bool integrated = false;
+  };
   void run();
-  void integratePacket(const KeyframePacket& kf);
+  /// Adds a keyframe to the free-space window and integrates those whose neighbours are there
+  /// (all of them when `flush`).
+  void advanceWindow(KeyframePacketPtr kf, bool flush);
+  void integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask);
   void rebuildIfNeeded();
   void applyUpdateLocked(const PoseUpdate& update);
 
@@ -79,6 +90,7 @@ class MappingWorker {
 
   mutable std::mutex backend_mutex_;  ///< guards backend_ and records_
   std::unordered_map<std::uint64_t, KeyframeRecord> records_;
+  std::deque<WindowEntry> window_;  ///< mapping thread (then finish()) only
   std::vector<std::uint64_t> order_;
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;

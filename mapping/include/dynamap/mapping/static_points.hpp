@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "dynamap/core/camera.hpp"
+#include "dynamap/mapping/free_space.hpp"
 
 namespace dynamap {
 
@@ -17,6 +18,7 @@ struct StaticPointsOptions {
   int mask_dilation_px = 5;              ///< dynamic mask grown by this radius (0 = as is)
   double depth_edge_threshold_m = 0.05;  ///< |depth jump| to a 4-neighbour marking an edge
   int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
+  FreeSpaceOptions free_space;  ///< MappingWorker: drop pixels that violate neighbours' free space
 };
 
 /// The static part of one RGB-D keyframe. The only place where masks become map input.

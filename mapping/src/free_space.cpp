@@ -1,0 +1,89 @@
+#include "dynamap/mapping/free_space.hpp"
+
+#include <algorithm>
+
+#include <opencv2/imgproc.hpp>
+
+namespace dynamap {
+
+namespace {
+
+constexpr float kNoReading = 1e3f;
+
+cv::Mat halfResolution(const cv::Mat& depth_m) {
+  cv::Mat half;
+  cv::resize(depth_m, half, cv::Size(depth_m.cols / 2, depth_m.rows / 2), 0, 0, cv::INTER_NEAREST);
+  return half;
+}
+
+/// Drops specks: opening, then connected regions smaller than min_area pixels.
+void keepLargeRegions(cv::Mat& mask, int min_area) {
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  for (int i = 1; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) < min_area) mask.setTo(0, labels == i);
+  }
+}
+
+void markViolations(const PinholeCamera& camera, const cv::Mat& half_depth_m,
+                    const Eigen::Isometry3d& T_W_C, const FreeSpaceView& ref,
+                    const FreeSpaceOptions& options, cv::Mat& flagged) {
+  const Eigen::Matrix4d T = (ref.T_W_C.inverse() * T_W_C).matrix();  // this camera -> ref
+  const double fx = camera.fx, fy = camera.fy, cx = camera.cx, cy = camera.cy;
+  const int w = ref.near_half_m.cols, h = ref.near_half_m.rows;
+  for (int v = 0; v < half_depth_m.rows; ++v) {
+    const float* row = half_depth_m.ptr<float>(v);
+    uchar* out = flagged.ptr<uchar>(v);
+    const double y_n = (2.0 * v - cy) / fy;
+    for (int u = 0; u < half_depth_m.cols; ++u) {
+      const double z = row[u];
+      if (z <= 0.0 || z > options.max_depth_m || out[u] != 0) continue;
+      const double x = (2.0 * u - cx) / fx * z, y = y_n * z;
+      const double xr = T(0, 0) * x + T(0, 1) * y + T(0, 2) * z + T(0, 3);
+      const double yr = T(1, 0) * x + T(1, 1) * y + T(1, 2) * z + T(1, 3);
+      const double zr = T(2, 0) * x + T(2, 1) * y + T(2, 2) * z + T(2, 3);
+      if (zr < 0.1) continue;
+      const int ur = cvRound(0.5 * (fx * xr / zr + cx)), vr = cvRound(0.5 * (fy * yr / zr + cy));
+      if (ur < 0 || vr < 0 || ur >= w || vr >= h) continue;
+      const double seen = ref.near_half_m.at<float>(vr, ur);
+      if (seen <= 0.0) continue;
+      if (zr < seen - options.margin_m - options.margin_per_m2 * seen * seen) out[u] = 255;
+    }
+  }
+}
+
+}  // namespace
+
+FreeSpaceView makeFreeSpaceView(const cv::Mat& depth_m, const Eigen::Isometry3d& T_W_C) {
+  FreeSpaceView view;
+  view.T_W_C = T_W_C;
+  if (depth_m.empty()) return view;
+  cv::Mat d = halfResolution(depth_m);
+  cv::Mat invalid = d <= 0.f;
+  d.setTo(kNoReading, invalid);
+  cv::erode(d, d, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));  // nearest in the window
+  d.setTo(0.f, d >= kNoReading);
+  view.near_half_m = d;
+  return view;
+}
+
+cv::Mat freeSpaceViolations(const PinholeCamera& camera, const cv::Mat& depth_m,
+                            const Eigen::Isometry3d& T_W_C,
+                            const std::vector<const FreeSpaceView*>& others,
+                            const FreeSpaceOptions& options) {
+  if (depth_m.empty()) return {};
+  const cv::Mat half = halfResolution(depth_m);
+  cv::Mat flagged = cv::Mat::zeros(half.size(), CV_8UC1);
+  for (const FreeSpaceView* other : others) {
+    if (other != nullptr && !other->near_half_m.empty()) {
+      markViolations(camera, half, T_W_C, *other, options, flagged);
+    }
+  }
+  keepLargeRegions(flagged, std::max(1, options.min_area_px / 4));
+  cv::Mat full;
+  cv::resize(flagged, full, depth_m.size(), 0, 0, cv::INTER_NEAREST);
+  return full;
+}
+
+}  // namespace dynamap
