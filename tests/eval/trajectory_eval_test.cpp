@@ -132,6 +132,32 @@ TEST(TrajectoryEval, RecoversKnownRigidTransformUnderNoise) {
   EXPECT_LT(computeAte(gt, exact, TrajectoryEvalOptions{}).error_m.max, 1e-9);
 }
 
+// A straight path (x axis, 40 cm) with 1 mm position noise: the positions leave the roll about
+// the path free, the orientations fix it. alignPoses recovers a 10 degree roll; the ATE's
+// position-only alignment need not.
+TEST(TrajectoryEval, PoseAlignmentFixesRollAboutAStraightPath) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();  // est frame -> gt frame
+  X.rotate(Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+  X.translation() = Eigen::Vector3d(0.3, -0.2, 0.1);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  std::vector<TimedPose> gt, est;
+  for (int k = 0; k < 100; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.rotate(Eigen::AngleAxisd(0.3 * std::sin(0.1 * k), Eigen::Vector3d::UnitY()));
+    T.translation() = Eigen::Vector3d(0.004 * k, 0.0, 0.0);
+    gt.push_back({0.1 * k, T});
+    Eigen::Isometry3d E = X.inverse() * T;
+    E.translation() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    est.push_back({0.1 * k, E});
+  }
+  const Alignment a = alignPoses(gt, est, 0.02);
+  EXPECT_LT(Eigen::AngleAxisd(a.R.transpose() * X.linear()).angle(), 0.2 * M_PI / 180.0);
+  EXPECT_LT((a.t - X.translation()).norm(), 0.005);
+  EXPECT_DOUBLE_EQ(a.scale, 1.0);
+  EXPECT_THROW(alignPoses(gt, {est.front()}, 0.02), EvaluationError);
+}
+
 TEST(TrajectoryEval, Sim3RecoversKnownScale) {
   const auto gt = syntheticTrajectory(400, 2);
   const Eigen::Isometry3d X = knownTransform();

@@ -105,7 +105,9 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
     try {
       const auto gt = readTrajectory(*gt_path);
       report.evaluation = evaluateTrajectories(gt, result.trajectory, TrajectoryEvalOptions{});
-      alignment = report.evaluation->ate.alignment;
+      // Maps are compared after a whole-pose alignment: the ATE's position-only alignment
+      // leaves the roll about a short, straight path free (alignPoses()).
+      alignment = alignPoses(gt, result.trajectory, TrajectoryEvalOptions{}.max_time_diff_s);
       metrics_json = evaluationToJson(*report.evaluation);
       TrajectoryPlotOptions plot;
       plot.title = "dynamap: " + fs::path(options.sequence_dir).filename().string();

@@ -135,6 +135,34 @@ Alignment alignPositions(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt
   return a;
 }
 
+Alignment alignPoses(const std::vector<TimedPose>& gt_in, const std::vector<TimedPose>& est_in,
+                     double max_time_diff_s, double rotation_weight_m2) {
+  const std::vector<TimedPose> gt = asTimeDict(gt_in);
+  const std::vector<TimedPose> est = asTimeDict(est_in);
+  const auto matches = associateTimestamps(stampsOf(gt), stampsOf(est), max_time_diff_s);
+  if (matches.size() < 2) throw EvaluationError("alignPoses: fewer than 2 associated pose pairs");
+  Eigen::Vector3d mean_gt = Eigen::Vector3d::Zero(), mean_est = Eigen::Vector3d::Zero();
+  for (const auto& [i_gt, i_est] : matches) {
+    mean_gt += gt[i_gt].T_W_C.translation();
+    mean_est += est[i_est].T_W_C.translation();
+  }
+  mean_gt /= static_cast<double>(matches.size());
+  mean_est /= static_cast<double>(matches.size());
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // maximise trace(R^T H)
+  for (const auto& [i_gt, i_est] : matches) {
+    H += (gt[i_gt].T_W_C.translation() - mean_gt) *
+         (est[i_est].T_W_C.translation() - mean_est).transpose();
+    H += rotation_weight_m2 * gt[i_gt].T_W_C.linear() * est[i_est].T_W_C.linear().transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) S(2, 2) = -1.0;
+  Alignment a;
+  a.R = svd.matrixU() * S * svd.matrixV().transpose();
+  a.t = mean_gt - a.R * mean_est;
+  return a;
+}
+
 AteResult computeAte(const std::vector<TimedPose>& gt_in, const std::vector<TimedPose>& est_in,
                      const TrajectoryEvalOptions& options) {
   const std::vector<TimedPose> gt = asTimeDict(gt_in);

@@ -81,6 +81,15 @@ struct TrajectoryEvaluation {
   RpeResult rpe;
 };
 
+/// Rigid alignment of the estimate onto the ground truth from whole poses, for comparing maps
+/// (not the benchmark's ATE alignment): maximises sum |p_gt - R p_est - t|^2 +
+/// rotation_weight_m2 * |R_gt - R R_est|_F^2 over associated pairs, one SVD of
+/// cov(p_gt, p_est) + rotation_weight_m2 * sum R_gt R_est^T. Positions alone leave the rotation
+/// about a (nearly) straight path free; the rest of the map swings with it, the camera
+/// orientations pin it down. Throws EvaluationError when fewer than 2 pairs associate.
+Alignment alignPoses(const std::vector<TimedPose>& gt, const std::vector<TimedPose>& est,
+                     double max_time_diff_s, double rotation_weight_m2 = 1.0);
+
 /// ATE as evaluate_ate.py. Throws EvaluationError when fewer than 2 pairs associate.
 AteResult computeAte(const std::vector<TimedPose>& gt, const std::vector<TimedPose>& est,
                      const TrajectoryEvalOptions& options);
