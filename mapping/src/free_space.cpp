@@ -1,6 +1,7 @@
 #include "dynamap/mapping/free_space.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -16,14 +17,35 @@ cv::Mat halfResolution(const cv::Mat& depth_m) {
   return half;
 }
 
-/// Drops specks: opening, then connected regions smaller than min_area pixels.
-void keepLargeRegions(cv::Mat& mask, int min_area) {
-  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+/// Drops specks: connected regions smaller than min_area pixels after an opening, except the
+/// (unopened) regions that touch `near_mover` (may be empty).
+void keepLargeRegions(cv::Mat& mask, int min_area, const cv::Mat& near_mover) {
+  cv::Mat opened;
+  cv::morphologyEx(mask, opened, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
   cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  const int n = cv::connectedComponentsWithStats(opened, labels, stats, centroids, 8, CV_32S);
   for (int i = 1; i < n; ++i) {
-    if (stats.at<int>(i, cv::CC_STAT_AREA) < min_area) mask.setTo(0, labels == i);
+    if (stats.at<int>(i, cv::CC_STAT_AREA) < min_area) opened.setTo(0, labels == i);
   }
+  if (!near_mover.empty() && cv::countNonZero(near_mover) > 0) {
+    const int m = cv::connectedComponents(mask, labels, 8, CV_32S);
+    std::vector<bool> touches(static_cast<std::size_t>(m), false);
+    for (int v = 0; v < mask.rows; ++v) {
+      const int* l = labels.ptr<int>(v);
+      const uchar* near = near_mover.ptr<uchar>(v);
+      for (int u = 0; u < mask.cols; ++u) {
+        if (l[u] > 0 && near[u] != 0) touches[static_cast<std::size_t>(l[u])] = true;
+      }
+    }
+    for (int v = 0; v < mask.rows; ++v) {
+      const int* l = labels.ptr<int>(v);
+      uchar* out = opened.ptr<uchar>(v);
+      for (int u = 0; u < mask.cols; ++u) {
+        if (l[u] > 0 && touches[static_cast<std::size_t>(l[u])]) out[u] = 255;
+      }
+    }
+  }
+  mask = opened;
 }
 
 void markViolations(const PinholeCamera& camera, const cv::Mat& half_depth_m,
@@ -71,7 +93,7 @@ FreeSpaceView makeFreeSpaceView(const cv::Mat& depth_m, const Eigen::Isometry3d&
 cv::Mat freeSpaceViolations(const PinholeCamera& camera, const cv::Mat& depth_m,
                             const Eigen::Isometry3d& T_W_C,
                             const std::vector<const FreeSpaceView*>& others,
-                            const FreeSpaceOptions& options) {
+                            const FreeSpaceOptions& options, const cv::Mat& dynamic_mask) {
   if (depth_m.empty()) return {};
   const cv::Mat half = halfResolution(depth_m);
   cv::Mat flagged = cv::Mat::zeros(half.size(), CV_8UC1);
@@ -80,7 +102,14 @@ cv::Mat freeSpaceViolations(const PinholeCamera& camera, const cv::Mat& depth_m,
       markViolations(camera, half, T_W_C, *other, options, flagged);
     }
   }
-  keepLargeRegions(flagged, std::max(1, options.min_area_px / 4));
+  cv::Mat near_mover;
+  if (!dynamic_mask.empty() && options.fringe_px > 0 && dynamic_mask.size() == depth_m.size()) {
+    cv::resize(dynamic_mask == 255, near_mover, half.size(), 0, 0, cv::INTER_NEAREST);
+    const int r = std::max(1, options.fringe_px / 2);
+    cv::dilate(near_mover, near_mover,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+  }
+  keepLargeRegions(flagged, std::max(1, options.min_area_px / 4), near_mover);
   cv::Mat full;
   cv::resize(flagged, full, depth_m.size(), 0, 0, cv::INTER_NEAREST);
   return full;

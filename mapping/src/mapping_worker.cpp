@@ -113,7 +113,7 @@ void MappingWorker::advanceWindow(KeyframePacketPtr kf, bool flush) {
         if (j != i) others.push_back(&window_[j].view);
       }
       const KeyframePacket& k = *window_[i].kf;
-      flagged = freeSpaceViolations(camera_, k.depth_m, k.T_W_C, others, fs);
+      flagged = freeSpaceViolations(camera_, k.depth_m, k.T_W_C, others, fs, k.dynamic_mask);
     }
     integratePacket(*window_[i].kf, flagged);
     window_[i].integrated = true;

@@ -115,6 +115,31 @@ TEST(FreeSpace, ObjectThatMovedIsFlaggedInEarlierAndLaterKeyframes) {
   }
 }
 
+// A small moved object (6 x 6 cm, ~450 px, below min_area_px) counts as noise on its own, but
+// is kept when it lies within fringe_px of the keyframe's mask: the rim of a masked mover.
+TEST(FreeSpace, SmallRegionIsKeptOnlyNextToTheMask) {
+  const PinholeCamera cam;
+  const Box before{Eigen::Vector3d(-0.5, 0.0, 1.5), 0.03};
+  const Box after{Eigen::Vector3d(0.3, 0.0, 1.5), 0.03};
+  const FreeSpaceView v0 = makeFreeSpaceView(render(cam, poseAt(0.0), &before), poseAt(0.0));
+  const cv::Mat d1 = render(cam, poseAt(0.1), &after);
+  const cv::Rect rim = boxRect(cam, after, 0.1);
+  ASSERT_LT(rim.area(), FreeSpaceOptions{}.min_area_px);
+  const std::vector<const FreeSpaceView*> others{&v0};
+  EXPECT_EQ(cv::countNonZero(freeSpaceViolations(cam, d1, poseAt(0.1), others, {})), 0);
+  cv::Mat mask = cv::Mat::zeros(d1.size(), CV_8UC1);
+  mask(cv::Rect(rim.x - 60, rim.y, 56, rim.height)).setTo(255);  // ends 4 px left of the rim
+  FreeSpaceOptions fringe;
+  fringe.fringe_px = 12;
+  const cv::Mat near = freeSpaceViolations(cam, d1, poseAt(0.1), others, fringe, mask);
+  EXPECT_GT(share(near, rim), 0.8);
+  EXPECT_EQ(cv::countNonZero(near(cv::Rect(0, 0, rim.x - 4, 480))), 0);  // the mask itself
+  FreeSpaceOptions no_fringe;
+  no_fringe.fringe_px = 0;
+  EXPECT_EQ(cv::countNonZero(freeSpaceViolations(cam, d1, poseAt(0.1), others, no_fringe, mask)),
+            0);
+}
+
 TEST(FreeSpace, SmallPoseErrorAndDepthNoiseFlagNothing) {
   const PinholeCamera cam;
   const Box still{Eigen::Vector3d(0.0, 0.0, 1.5)};

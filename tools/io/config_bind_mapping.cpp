@@ -16,6 +16,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.free_space_margin_m", &s.free_space.margin_m, 0.0, 10.0);
   schema.addDouble("mapping.free_space_margin_per_m2", &s.free_space.margin_per_m2, 0.0, 10.0);
   schema.addInt("mapping.free_space_min_area_px", &s.free_space.min_area_px, 1, 1000000);
+  schema.addInt("mapping.free_space_fringe_px", &s.free_space.fringe_px, 0, 100);
 }
 
 }  // namespace dynamap
