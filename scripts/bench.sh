@@ -26,11 +26,15 @@ for mode in off both; do run "teddy__$mode" "$TEDDY" --set dynamic.mode=$mode "$
 for mode in off geometry detector both; do
   run "teddy_dyn_dev__$mode" "$DYN" --set dynamic.mode=$mode "${TSDF[@]}"
 done
+# Ablation of the mapping side's free-space check (README, Mapping backends).
+NOFS=(--set mapping.free_space_check=false)
+run "teddy_dyn_dev__both-nofreespace" "$DYN" --set dynamic.mode=both "${TSDF[@]}" "${NOFS[@]}"
 # Tracking runs differ from run to run (bundle adjustment and the detector run on their own
 # threads): REPEATS runs of the ATE comparisons, summarised as median and range.
 for i in $(seq 2 "${REPEATS:-3}"); do
   for mode in off both; do run "teddy__${mode}_r$i" "$TEDDY" --set dynamic.mode=$mode "${TSDF[@]}"; done
   run "teddy_dyn_dev__both_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}"
+  run "teddy_dyn_dev__both-nofreespace_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}" "${NOFS[@]}"
 done
 for backend in points pcl_voxel vdb_tsdf octomap; do
   run "teddy_dyn_dev__gt-poses-masks_$backend" "$DYN" --poses "$DYN/groundtruth.txt" \

@@ -79,16 +79,20 @@ def repeats(rows):
     print()
     print("Repeated runs (same command; threads make runs differ):")
     print()
-    print("| sequence | run | runs | ATE RMSE cm median (min–max) | mask IoU median | standing masked median |")
-    print("|---|---|---|---|---|---|")
+    print("| sequence | run | runs | ATE RMSE cm median (min–max) | mask IoU median "
+          "| standing masked median (max) | map precision / completeness / ghost median "
+          "| ghost max | frames/s median |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for (seq, label), xs in sorted(groups.items()):
-        ate = [x["ate_cm"] for x in xs if x["ate_cm"] is not None]
-        iou = [x["iou"] for x in xs if x["iou"] is not None]
-        st = [x["standing"] for x in xs if x["standing"] is not None]
+        col = lambda k: [x[k] for x in xs if x[k] is not None]
         med = lambda v, s, d: fmt(statistics.median(v), s, d) if v else "–"
+        top = lambda v, s, d: fmt(max(v), s, d) if v else "–"
+        ate, st, ghost = col("ate_cm"), col("standing"), col("ghost")
         rng = f"({fmt(min(ate), 100, 2)}–{fmt(max(ate), 100, 2)})" if ate else ""
-        print(f"| {seq} | {label} | {len(xs)} | {med(ate, 100, 2)} {rng} | {med(iou, 1, 3)} "
-              f"| {med(st, 100, 1)} % |")
+        print(f"| {seq} | {label} | {len(xs)} | {med(ate, 100, 2)} {rng} "
+              f"| {med(col('iou'), 1, 3)} | {med(st, 100, 1)} % ({top(st, 100, 1)} %) "
+              f"| {med(col('prec'), 1, 3)} / {med(col('comp'), 1, 3)} / {med(ghost, 100, 2)} % "
+              f"| {top(ghost, 100, 2)} % | {med(col('fps'), 1, 1)} |")
 
 
 if __name__ == "__main__":
