@@ -7,6 +7,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh >/dev/null
+# The Open3D peer (ScalableTSDFVolume, RGB-D odometry) is measured when python3-open3d is there;
+# install it when we can (root + apt), otherwise the tables say it is missing.
+if ! /usr/bin/python3 -c 'import open3d' >/dev/null 2>&1 && [ "$(id -u)" = 0 ] &&
+  command -v apt-get >/dev/null 2>&1; then
+  apt-get install -y -qq --no-install-recommends python3-open3d >/dev/null 2>&1 ||
+    { apt-get update -qq && apt-get install -y -qq --no-install-recommends python3-open3d >/dev/null; } ||
+    echo "bench: could not install python3-open3d; Open3D columns will say so" >&2
+fi
 OUT=${OUT:-runs/bench}
 DATA=../shared/data
 TEDDY=$DATA/tum/rgbd_dataset_freiburg3_teddy
@@ -40,6 +48,19 @@ for backend in points pcl_voxel vdb_tsdf octomap; do
   run "teddy_dyn_dev__gt-poses-masks_$backend" "$DYN" --poses "$DYN/groundtruth.txt" \
     --masks "$DYN/mask" --set mapping.backend=$backend
 done
+
+# Peer tracker on the same frames: Open3D's frame-to-frame RGB-D odometry (colour and hybrid terms).
+if /usr/bin/python3 -c 'import open3d' >/dev/null 2>&1; then
+  mkdir -p "$OUT/peers"
+  for spec in "teddy:$TEDDY:color" "teddy:$TEDDY:hybrid" "teddy_dyn_dev:$DYN:color"; do
+    IFS=: read -r name seq term <<<"$spec"
+    stem="$OUT/peers/${name}__open3d_$term"
+    echo "bench: $name open3d odometry ($term)" >&2
+    { OMP_NUM_THREADS=2 /usr/bin/python3 scripts/o3d_odometry_bench.py "$seq" "$term" "$stem.txt" >"$stem.timing.json" &&
+      ./build/bin/dynamap evaluate --gt "$seq/groundtruth.txt" --est "$stem.txt" --json >"$stem.eval.json"; } 2>"$stem.log" ||
+      echo "bench: open3d odometry on $name ($term) failed (see $stem.log)" >&2
+  done
+fi
 
 cmake --build build -j2 --target dynamap_map_bench >/dev/null
 ./build/bin/dynamap_map_bench --data "$DYN" --open3d --out "$OUT/map_bench" >"$OUT/map_bench.md" 2>"$OUT/map_bench.log" ||

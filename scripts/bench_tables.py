@@ -64,6 +64,7 @@ def main(runs_dir):
               f"| {fmt(x['map_ms'], 1, 1)} | {fmt(x['prec'])} / {fmt(x['comp'])} / {fmt(x['ghost'], 1, 4)} "
               f"| {fmt(x['mem'], 1, 0)} |")
     repeats(rows)
+    peers(rows, runs_dir)
 
 
 def repeats(rows):
@@ -81,8 +82,8 @@ def repeats(rows):
     print()
     print("| sequence | run | runs | ATE RMSE cm median (min–max) | mask IoU median "
           "| standing masked median (max) | map precision / completeness / ghost median "
-          "| ghost max | frames/s median |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| ghost max | frames/s median | tracking median ms (median of runs) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for (seq, label), xs in sorted(groups.items()):
         col = lambda k: [x[k] for x in xs if x[k] is not None]
         med = lambda v, s, d: fmt(statistics.median(v), s, d) if v else "–"
@@ -92,7 +93,37 @@ def repeats(rows):
         print(f"| {seq} | {label} | {len(xs)} | {med(ate, 100, 2)} {rng} "
               f"| {med(col('iou'), 1, 3)} | {med(st, 100, 1)} % ({top(st, 100, 1)} %) "
               f"| {med(col('prec'), 1, 3)} / {med(col('comp'), 1, 3)} / {med(ghost, 100, 2)} % "
-              f"| {top(ghost, 100, 2)} % | {med(col('fps'), 1, 1)} |")
+              f"| {top(ghost, 100, 2)} % | {med(col('fps'), 1, 1)} | {med(col('track_ms'), 1, 1)} |")
+
+
+def peers(rows, runs_dir):
+    """Open3D RGB-D odometry on the same frames (RUNS_DIR/peers, written by scripts/bench.sh)."""
+    d = os.path.join(runs_dir, "peers")
+    if not os.path.isdir(d):
+        return
+    print()
+    print("Peer on the same frames in the same run: Open3D frame-to-frame RGB-D odometry "
+          "(python3-open3d, `scripts/o3d_odometry_bench.py`), against dynamap's medians over the "
+          "repeated `both` runs above:")
+    print()
+    print("| sequence | tracker | ATE RMSE cm | failed frames | ms per frame (median) "
+          "| dynamap ATE cm | peer ATE / dynamap ATE | peer ms / dynamap tracking ms |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name in sorted(os.listdir(d)):
+        if not name.endswith(".eval.json"):
+            continue
+        stem = name[: -len(".eval.json")]
+        seq, label = stem.split("__", 1)
+        ev, tm = load(os.path.join(d, name)), load(os.path.join(d, stem + ".timing.json"))
+        ate, ms = ev.get("ate", {}).get("rmse_m"), tm.get("ms_per_frame_median")
+        ours = [x for x in rows if x["seq"] == seq and re.match(r"^both(_r\d+)?$", x["label"])]
+        our_ate = [x["ate_cm"] for x in ours if x["ate_cm"] is not None]
+        our_ms = [x["track_ms"] for x in ours if x["track_ms"] is not None]
+        oa = statistics.median(our_ate) if our_ate else None
+        om = statistics.median(our_ms) if our_ms else None
+        ratio = lambda a, b: f"{a / b:.1f} x" if a is not None and b else "–"
+        print(f"| {seq} | {label} | {fmt(ate, 100, 2)} | {tm.get('failed', '–')} "
+              f"| {fmt(ms, 1, 0)} | {fmt(oa, 100, 2)} | {ratio(ate, oa)} | {ratio(ms, om)} |")
 
 
 if __name__ == "__main__":
