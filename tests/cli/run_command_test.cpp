@@ -164,6 +164,10 @@ TEST(RunCommand, RealtimeModeKeepsTrackingLagBounded) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string run_json = test::readFile((out / "run.json").string());
   EXPECT_NE(run_json.find("\"realtime\""), std::string::npos) << run_json;
+  // Real time: the newest frame wins, nothing waits in lockstep (offline runs do).
+  const AppConfig effective = loadAppConfig((out / "config.yaml").string(), {});
+  EXPECT_FALSE(effective.tracking.ba_lockstep);
+  EXPECT_FALSE(effective.dynamic.detector_lockstep);
   // Frames arrive at 30 Hz; stale frames are skipped so that tracking never falls far behind.
   // The bound is 0.5 s; p95 of the lag is asserted against it.
   const std::string timings = test::readFile((out / "timings.json").string());

@@ -34,6 +34,12 @@ int runCommand(const RunOptions& cli) {
               << kDownloadHelp << "\n";
     return 2;
   }
+  if (options.realtime) {
+    // Real time: the newest frame wins, so the detector and BA must not hold tracking in
+    // lockstep (offline runs keep it and repeat exactly). A later --set still wins.
+    options.overrides.insert(options.overrides.begin(),
+                             {"tracking.ba_lockstep=false", "dynamic.detector_lockstep=false"});
+  }
   std::string effective_yaml;
   const AppConfig config = loadAppConfig(options.config_path, options.overrides, &effective_yaml);
   DatasetOptions dataset;

@@ -33,6 +33,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.nms_dedup_iou", &c.nms_dedup_iou, 0.0, 1.0);
   schema.addInt("dynamic.detector_threads", &c.detector_threads, 0, 256);
   schema.addBool("dynamic.detector_async", &c.detector_async);
+  schema.addBool("dynamic.detector_lockstep", &c.detector_lockstep);
   schema.addInt("dynamic.detector_max_age_frames", &c.detector_max_age_frames, 0, 1000);
   schema.addDouble("dynamic.stale_box_growth_px", &c.stale_box_growth_px, 0.0, 100.0);
 

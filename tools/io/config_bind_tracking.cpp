@@ -39,6 +39,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
 
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
+  schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);

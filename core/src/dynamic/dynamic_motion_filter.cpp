@@ -178,10 +178,27 @@ void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
   ++frame_no_;
   begun_stamp_ = frame.timestamp_s;
   if (!worker_ || frame.bgr.empty()) return;
-  const bool wait = !config_.detector_async;
+  const bool lockstep = config_.detector_async && config_.detector_lockstep;
+  if (lockstep) {  // the previous frame's detections, whatever the threads' timing
+    const auto start = Clock::now();
+    Worker::Result previous;
+    if (worker_->take(&previous, true)) {
+      keepDetections(std::move(previous.detections), previous.frame_no, previous.stamp);
+    }
+    record("detector_wait", msSince(start));
+  }
+  const bool wait = !config_.detector_async || lockstep;
   if (!worker_->submit(frame.bgr, frame_no_, frame.timestamp_s, wait)) {
     record("detector_skipped", 0.0);
   }
+}
+
+void DynamicMotionFilter::keepDetections(std::vector<Detection> detections, long frame_no,
+                                         double stamp) {
+  latest_.detections = std::move(detections);
+  latest_.frame_no = frame_no;
+  latest_.stamp = stamp;
+  record("detector_fresh", 0.0);
 }
 
 std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* frame) {
@@ -190,13 +207,13 @@ std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* f
   const auto start = Clock::now();
   Worker::Result fresh;
   const bool sync = !config_.detector_async;
-  if (worker_->take(&fresh, sync)) {
-    latest_.detections = std::move(fresh.detections);
-    latest_.frame_no = fresh.frame_no;
-    latest_.stamp = fresh.stamp;
-    record("detector_fresh", 0.0);
+  // Lockstep: beginFrame() already took the previous frame's result.
+  if (!config_.detector_lockstep || sync) {
+    if (worker_->take(&fresh, sync)) {
+      keepDetections(std::move(fresh.detections), fresh.frame_no, fresh.stamp);
+    }
+    record("detector_wait", msSince(start));
   }
-  record("detector_wait", msSince(start));
   if (sync) {  // the frame's own detections (beginFrame() not called for it: detect now)
     if (begun && latest_.frame_no == frame_no_) return latest_.detections;
     return worker_->runNow(frame->bgr);

@@ -59,11 +59,16 @@ void LocalBundleAdjuster::start() {
 }
 
 void LocalBundleAdjuster::requestRun() {
+  // ba_lockstep: the window is taken now, on the tracker's thread, so that what the BA sees
+  // (landmarks marked bad per frame included) does not depend on when its thread wakes up.
+  std::optional<BaWindow> job;
+  if (config_.ba_lockstep) job = map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = true;
+    job_ = std::move(job);
   }
-  wake_.notify_one();
+  wake_.notify_all();
 }
 
 void LocalBundleAdjuster::stop() {
@@ -84,6 +89,19 @@ void LocalBundleAdjuster::runOnce() {
   updates_.insert(updates_.end(), moved.begin(), moved.end());
 }
 
+void LocalBundleAdjuster::applyFinished() {
+  std::optional<BaWindow> solved;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait(lock, [this] { return (!pending_ && !running_) || !thread_.joinable() || stop_; });
+    solved.swap(solved_);
+  }
+  if (!solved) return;
+  std::vector<PoseUpdate> moved = map_.apply(*solved);
+  std::lock_guard<std::mutex> lock(updates_mutex_);
+  updates_.insert(updates_.end(), moved.begin(), moved.end());
+}
+
 std::vector<PoseUpdate> LocalBundleAdjuster::takeUpdates() {
   std::lock_guard<std::mutex> lock(updates_mutex_);
   std::vector<PoseUpdate> out;
@@ -92,14 +110,30 @@ std::vector<PoseUpdate> LocalBundleAdjuster::takeUpdates() {
 }
 
 void LocalBundleAdjuster::loop() {
+  std::optional<BaWindow> job;
   for (;;) {
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [this] { return pending_ || stop_; });
       if (stop_) return;
       pending_ = false;
+      running_ = true;
+      job.swap(job_);
     }
-    runOnce();
+    if (job) {
+      ScopedStageTimer timer(timings_, "ba");
+      const bool ok = solveBundleAdjustment(camera_, config_, *job);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (ok) solved_ = std::move(job);
+      job.reset();
+    } else {
+      runOnce();
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      running_ = false;
+    }
+    wake_.notify_all();
   }
 }
 

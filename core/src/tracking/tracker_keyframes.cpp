@@ -109,6 +109,8 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     fresh_depth.push_back(z);
   }
   if (!initialized_ && static_cast<int>(fresh.size()) < kMinInitialLandmarks) return nullptr;
+  // ba_lockstep: the last keyframe's BA result lands here, at a point fixed by the frames alone.
+  if (config_.bundle_adjustment && config_.ba_lockstep) ba_.applyFinished();
 
   std::vector<KeyframeObservation> observations;
   observations.reserve(tracks_.size() + fresh.size());
@@ -175,7 +177,10 @@ void Tracker::Impl::finish() {
   if (finished_) return;
   finished_ = true;
   ba_.stop();
-  if (config_.bundle_adjustment) ba_.runOnce();
+  if (config_.bundle_adjustment) {
+    ba_.applyFinished();  // ba_lockstep: a solve finished but not yet written
+    ba_.runOnce();
+  }
 }
 
 std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory() const {

@@ -58,6 +58,11 @@ struct DynamicConfig {
   /// newest finished detections, their boxes grown by stale_box_growth_px per frame of age.
   /// false: every frame is detected and filter() waits for its own detections.
   bool detector_async = true;
+  /// With detector_async: true = frame i always uses the detections of frame i-1 (beginFrame()
+  /// waits for them, then hands frame i over), so an offline run repeats exactly and the
+  /// detector still overlaps tracking; false = the newest finished detections, frames arriving
+  /// while the detector is busy are skipped (`--realtime` sets false).
+  bool detector_lockstep = true;
   int detector_max_age_frames = 6;   ///< older detections are not used (async)
   double stale_box_growth_px = 3.0;  ///< per frame of age, on every side (async)
 

@@ -52,8 +52,12 @@ struct TrackerConfig {
 
   // --- local bundle adjustment (own thread) ---
   bool bundle_adjustment = true;  ///< local BA on its own thread
-  int ba_window = 8;              ///< keyframes optimised together
-  int ba_fixed_keyframes = 1;     ///< oldest keyframes of the window held fixed (gauge)
+  /// true: a BA result reaches the map when the next keyframe is made (the tracker waits for
+  /// the solve in flight there), so an offline run repeats exactly; false: as soon as the BA
+  /// thread finishes, whatever frame the tracker is on (`--realtime` sets false).
+  bool ba_lockstep = true;
+  int ba_window = 8;           ///< keyframes optimised together
+  int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
   int ba_max_iterations = 10;
 
   // --- relocalization ---

@@ -59,6 +59,7 @@ class DynamicMotionFilter : public MotionFilter {
   class Worker;
   void record(const std::string& stage, double ms);
   std::vector<Detection> currentDetections(const RgbdFrame* frame);
+  void keepDetections(std::vector<Detection> detections, long frame_no, double stamp);
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets);
 

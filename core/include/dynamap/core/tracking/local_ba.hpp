@@ -2,6 +2,7 @@
 
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -21,6 +22,9 @@ bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& con
 /// Local bundle adjustment on its own thread. requestRun() (after each new keyframe) never
 /// blocks; the thread snapshots the window, solves without holding the map lock and writes the
 /// result back under it. Corrected keyframe poses queue up for takeUpdates(). Thread-safe.
+/// With TrackerConfig::ba_lockstep the solved window is held back instead, until the tracker
+/// calls applyFinished() (before its next keyframe): it waits for the solve in flight and writes
+/// the result then, so the frames that see it do not depend on thread timing.
 class LocalBundleAdjuster {
  public:
   LocalBundleAdjuster(const PinholeCamera& camera, const TrackerConfig& config, LocalMap& map,
@@ -34,6 +38,8 @@ class LocalBundleAdjuster {
   void stop();     ///< finishes the running solve, joins; idempotent
   void runOnce();  ///< one synchronous solve in the caller's thread
   std::vector<PoseUpdate> takeUpdates();
+  /// ba_lockstep: waits for the requested/running solve and writes its result to the map.
+  void applyFinished();
 
  private:
   void loop();
@@ -45,7 +51,10 @@ class LocalBundleAdjuster {
   std::mutex mutex_;
   std::condition_variable wake_;
   bool pending_ = false;
+  bool running_ = false;
   bool stop_ = false;
+  std::optional<BaWindow> job_;     ///< ba_lockstep: the window requestRun() took
+  std::optional<BaWindow> solved_;  ///< ba_lockstep: a finished solve not yet written
   std::thread thread_;
   std::mutex updates_mutex_;
   std::vector<PoseUpdate> updates_;
