@@ -37,8 +37,8 @@ done
 # Ablation of the mapping side's free-space check (README, Mapping backends).
 NOFS=(--set mapping.free_space_check=false)
 run "teddy_dyn_dev__both-nofreespace" "$DYN" --set dynamic.mode=both "${TSDF[@]}" "${NOFS[@]}"
-# Tracking runs differ from run to run (bundle adjustment and the detector run on their own
-# threads): REPEATS runs of the ATE comparisons, summarised as median and range.
+# Offline runs are deterministic (tracking.ba_lockstep, dynamic.detector_lockstep), so repeats
+# check that and show the spread of the timings: REPEATS runs, summarised as median and range.
 for i in $(seq 2 "${REPEATS:-3}"); do
   for mode in off both; do run "teddy__${mode}_r$i" "$TEDDY" --set dynamic.mode=$mode "${TSDF[@]}"; done
   run "teddy_dyn_dev__both_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}"

@@ -78,7 +78,8 @@ def repeats(rows):
     if not groups:
         return
     print()
-    print("Repeated runs (same command; threads make runs differ):")
+    print("Repeated runs (same command; offline runs are deterministic, so accuracy repeats and "
+          "only the timings differ):")
     print()
     print("| sequence | run | runs | ATE RMSE cm median (min–max) | mask IoU median "
           "| standing masked median (max) | map precision / completeness / ghost median "

@@ -23,7 +23,7 @@ std::vector<std::string> dynDevArgs(const fs::path& out, std::vector<std::string
                                    "--out",
                                    out.string(),
                                    "--set",
-                                   "dataset.max_frames=60",
+                                   "dataset.max_frames=40",
                                    "--set",
                                    "mapping.backend=points",
                                    "--save-masks",
@@ -53,7 +53,7 @@ TEST(Determinism, OfflineRunsWithDetectorAndBundleAdjustmentRepeatExactly) {
     EXPECT_EQ(test::readFile(entry.path().string()), test::readFile(other.string()))
         << entry.path().filename();
   }
-  EXPECT_GE(masks, 5u);  // keyframes of 60 frames with walkers in every one
+  EXPECT_GE(masks, 5u);  // keyframes of 40 frames with walkers in every one
 }
 
 }  // namespace
