@@ -3,7 +3,7 @@
 # without motion-area removal, the removal ablations, every mapping backend from ground-truth
 # poses and masks) and the mapping component benchmark, then writes the generated section of
 # BENCHMARKS.md (machine, date, command, tables). Offline mode: every frame, as fast as possible.
-# usage: [REPEATS=3] scripts/bench.sh   (about 10-15 minutes on 2 cores)
+# usage: [REPEATS=3] scripts/bench.sh   (about 8 minutes on 2 cores with REPEATS=3)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh >/dev/null
