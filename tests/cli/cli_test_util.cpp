@@ -66,8 +66,9 @@ CommandResult runDynamap(const std::vector<std::string>& args, double interrupt_
   return result;
 }
 
-std::string makeTeddySubset(const std::string& name, std::size_t frames) {
-  const fs::path src = sharedData() / "tum" / "rgbd_dataset_freiburg3_teddy";
+std::string makeTeddySubset(const std::string& name, std::size_t frames,
+                            const std::string& source) {
+  const fs::path src = sharedData() / source;
   const fs::path dir = freshTempDir(name);
   fs::create_directories(dir / "rgb");
   fs::create_directories(dir / "depth");

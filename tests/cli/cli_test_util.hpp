@@ -20,6 +20,7 @@ std::size_t countDataLines(const std::string& path);  ///< non-empty lines not s
 
 /// A TUM sequence folder with the first `frames` frames of the real teddy sequence (images are
 /// symlinks) and its ground truth.
-std::string makeTeddySubset(const std::string& name, std::size_t frames);
+std::string makeTeddySubset(const std::string& name, std::size_t frames,
+                            const std::string& source = "tum/rgbd_dataset_freiburg3_teddy");
 
 }  // namespace dynamap::test
