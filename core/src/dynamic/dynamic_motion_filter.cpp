@@ -38,11 +38,7 @@ bool inMask(const cv::Mat& mask, const cv::Point2f& p) {
 /// number so that results can be aged.
 class DynamicMotionFilter::Worker {
  public:
-  struct Result {
-    std::vector<Detection> detections;
-    long frame_no = -1;
-    double stamp = 0.0;
-  };
+  using Result = DynamicMotionFilter::LatestDetections;
 
   Worker(std::unique_ptr<ObjectDetector> detector, int threads, DynamicMotionFilter* owner)
       : detector_(std::move(detector)),
@@ -178,42 +174,28 @@ void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
   ++frame_no_;
   begun_stamp_ = frame.timestamp_s;
   if (!worker_ || frame.bgr.empty()) return;
-  const bool lockstep = config_.detector_async && config_.detector_lockstep;
-  if (lockstep) {  // the previous frame's detections, whatever the threads' timing
-    const auto start = Clock::now();
-    Worker::Result previous;
-    if (worker_->take(&previous, true)) {
-      keepDetections(std::move(previous.detections), previous.frame_no, previous.stamp);
-    }
-    record("detector_wait", msSince(start));
-  }
-  const bool wait = !config_.detector_async || lockstep;
+  if (lockstep()) takeDetections(true);  // the previous frame's, whatever the threads' timing
+  const bool wait = !config_.detector_async || lockstep();
   if (!worker_->submit(frame.bgr, frame_no_, frame.timestamp_s, wait)) {
     record("detector_skipped", 0.0);
   }
 }
 
-void DynamicMotionFilter::keepDetections(std::vector<Detection> detections, long frame_no,
-                                         double stamp) {
-  latest_.detections = std::move(detections);
-  latest_.frame_no = frame_no;
-  latest_.stamp = stamp;
-  record("detector_fresh", 0.0);
+bool DynamicMotionFilter::lockstep() const {
+  return config_.detector_async && config_.detector_lockstep;
+}
+
+void DynamicMotionFilter::takeDetections(bool wait) {
+  const auto start = Clock::now();
+  if (worker_->take(&latest_, wait)) record("detector_fresh", 0.0);
+  record("detector_wait", msSince(start));
 }
 
 std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* frame) {
   if (!worker_ || frame == nullptr || frame->bgr.empty()) return {};
   const bool begun = frame_no_ >= 0 && frame->timestamp_s == begun_stamp_;
-  const auto start = Clock::now();
-  Worker::Result fresh;
   const bool sync = !config_.detector_async;
-  // Lockstep: beginFrame() already took the previous frame's result.
-  if (!config_.detector_lockstep || sync) {
-    if (worker_->take(&fresh, sync)) {
-      keepDetections(std::move(fresh.detections), fresh.frame_no, fresh.stamp);
-    }
-    record("detector_wait", msSince(start));
-  }
+  if (!lockstep()) takeDetections(sync);  // lockstep: beginFrame() took them
   if (sync) {  // the frame's own detections (beginFrame() not called for it: detect now)
     if (begun && latest_.frame_no == frame_no_) return latest_.detections;
     return worker_->runNow(frame->bgr);

@@ -62,7 +62,7 @@ void LocalBundleAdjuster::requestRun() {
   // ba_lockstep: the window is taken now, on the tracker's thread, so that what the BA sees
   // (landmarks marked bad per frame included) does not depend on when its thread wakes up.
   std::optional<BaWindow> job;
-  if (config_.ba_lockstep) job = map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
+  if (config_.ba_lockstep) job = snapshot();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = true;
@@ -80,13 +80,24 @@ void LocalBundleAdjuster::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-void LocalBundleAdjuster::runOnce() {
+BaWindow LocalBundleAdjuster::snapshot() const {
+  return map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
+}
+
+bool LocalBundleAdjuster::solve(BaWindow& window) {
   ScopedStageTimer timer(timings_, "ba");
-  BaWindow window = map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
-  if (!solveBundleAdjustment(camera_, config_, window)) return;
-  std::vector<PoseUpdate> moved = map_.apply(window);
+  return solveBundleAdjustment(camera_, config_, window);
+}
+
+void LocalBundleAdjuster::write(const BaWindow& solved) {
+  std::vector<PoseUpdate> moved = map_.apply(solved);
   std::lock_guard<std::mutex> lock(updates_mutex_);
   updates_.insert(updates_.end(), moved.begin(), moved.end());
+}
+
+void LocalBundleAdjuster::runOnce() {
+  BaWindow window = snapshot();
+  if (solve(window)) write(window);
 }
 
 void LocalBundleAdjuster::applyFinished() {
@@ -96,10 +107,7 @@ void LocalBundleAdjuster::applyFinished() {
     wake_.wait(lock, [this] { return (!pending_ && !running_) || !thread_.joinable() || stop_; });
     solved.swap(solved_);
   }
-  if (!solved) return;
-  std::vector<PoseUpdate> moved = map_.apply(*solved);
-  std::lock_guard<std::mutex> lock(updates_mutex_);
-  updates_.insert(updates_.end(), moved.begin(), moved.end());
+  if (solved) write(*solved);
 }
 
 std::vector<PoseUpdate> LocalBundleAdjuster::takeUpdates() {
@@ -120,17 +128,13 @@ void LocalBundleAdjuster::loop() {
       running_ = true;
       job.swap(job_);
     }
-    if (job) {
-      ScopedStageTimer timer(timings_, "ba");
-      const bool ok = solveBundleAdjustment(camera_, config_, *job);
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (ok) solved_ = std::move(job);
-      job.reset();
-    } else {
-      runOnce();
-    }
+    if (!job) job = snapshot();  // not lockstep: the map as it is now
+    const bool solved = solve(*job);
+    if (solved && !config_.ba_lockstep) write(*job);
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (solved && config_.ba_lockstep) solved_ = std::move(job);
+      job.reset();
       running_ = false;
     }
     wake_.notify_all();

@@ -59,7 +59,10 @@ class DynamicMotionFilter : public MotionFilter {
   class Worker;
   void record(const std::string& stage, double ms);
   std::vector<Detection> currentDetections(const RgbdFrame* frame);
-  void keepDetections(std::vector<Detection> detections, long frame_no, double stamp);
+  bool lockstep() const;  ///< detector_async && detector_lockstep
+  /// Moves the worker's newest finished detections (with `wait`, of the frame in flight) into
+  /// latest_, if there are any.
+  void takeDetections(bool wait);
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets);
 

@@ -43,6 +43,9 @@ class LocalBundleAdjuster {
 
  private:
   void loop();
+  BaWindow snapshot() const;           ///< the current window of the map
+  bool solve(BaWindow& window);        ///< timed as "ba"; false = nothing solved
+  void write(const BaWindow& solved);  ///< into the map; moved poses queue for takeUpdates()
 
   PinholeCamera camera_;
   TrackerConfig config_;
