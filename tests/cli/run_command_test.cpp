@@ -60,6 +60,28 @@ TEST(RunCommand, WritesEveryOutputOnARealSequence) {
   EXPECT_NEAR(rmse_at(eval.out), rmse_at(metrics), 1e-9);
 }
 
+TEST(RunCommand, ColourFramesWithoutDepthAreKeptOrDroppedAsConfigured) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  const std::string seq = test::makeTeddySubset("cli_unassoc", 12);
+  // Depth frames 3..5 removed from the list: colour frames 3..5 have no depth within 20 ms.
+  const fs::path depth_list = fs::path(seq) / "depth.txt";
+  std::ifstream in(depth_list);
+  std::string kept, line;
+  for (int n = 0; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || n++ < 3 || n > 6) kept += line + "\n";
+  }
+  in.close();
+  std::ofstream(depth_list) << kept;
+  for (const bool keep : {true, false}) {
+    const fs::path out = test::freshTempDir(keep ? "cli_unassoc_keep" : "cli_unassoc_drop");
+    const auto r = runDynamap(runArgs(
+        seq, out.string(),
+        {"--set", std::string("dataset.keep_unassociated_rgb=") + (keep ? "true" : "false")}));
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    EXPECT_EQ(test::countDataLines((out / "trajectory.txt").string()), keep ? 12u : 9u);
+  }
+}
+
 TEST(RunCommand, UnknownConfigKeyIsOneClearError) {
   DYNAMAP_REQUIRE_SHARED_DATA();
   const std::string seq = test::makeTeddySubset("cli_badkey", 5);

@@ -134,5 +134,17 @@ TEST(RigidCheck, DepthMakesTheCheckSeeMotionAlongEpipolarLines) {
   EXPECT_NEAR(cv::norm(motion.tvec + cv::Vec3d(v.R.t() * v.t)), 0.0, 0.01);
 }
 
+TEST(RigidCheck, BlankDepthFallsBackToTheEpipolarCheck) {
+  // A colour frame with no depth (none recorded near it, or a blank image): every point would
+  // look "far"; the check must not fit a rigid motion to 12 m points but use F instead.
+  const TwoViews v = makeViews(300, 40, 0.2, 11);
+  const cv::Mat blank = cv::Mat::zeros(480, 640, CV_32F);
+  const EpipolarResult r = checkRigidMotion(v.prev_px, v.cur_px, blank,
+                                            cv::Vec4d(500, 500, 320, 240), {}, EpipolarOptions{});
+  EXPECT_NE(r.model, EpipolarModel::kRigid);
+  const FlagRates f = rates(v, r.is_dynamic);
+  EXPECT_LE(f.stat, 0.05);
+}
+
 }  // namespace
 }  // namespace dynamap

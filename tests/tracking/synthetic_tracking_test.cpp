@@ -103,6 +103,26 @@ TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
   EXPECT_EQ(s.tracked + s.relocalized + s.lost + s.bad_frames, s.frames);
 }
 
+TEST(SyntheticTracking, FrameWithoutDepthIsPosedButMakesNoKeyframe) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 14);
+  scene.addDefaultRoom();
+  TrackerConfig config;
+  config.kf_max_interval_s = 0.01;  // every frame asks for a keyframe
+  Tracker tracker(camera, config, nullptr);
+  constexpr int kNoDepth = 12;
+  for (int i = 0; i < 20; ++i) {
+    auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    if (i == kNoDepth) r.depth_m.setTo(0.f);
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    EXPECT_EQ(res.status, FrameStatus::kTracked) << "frame " << i;
+    // No landmark can start without depth: the frame is posed by reprojection alone, and the
+    // next frame (with depth) becomes the keyframe instead.
+    EXPECT_EQ(res.is_keyframe, i != kNoDepth) << "frame " << i;
+    EXPECT_LT(translationError(res.T_W_C, i), 0.01) << "frame " << i;
+  }
+}
+
 /// Flags every match and masks every pixel of the moving box (from the renderer's mask).
 class OracleMotionFilter : public MotionFilter {
  public:

@@ -47,6 +47,7 @@ int runCommand(const RunOptions& cli) {
   dataset.depth_scale = config.camera.depth_scale;
   dataset.camera = config.resolvedCamera();
   dataset.max_frames = config.dataset.max_frames;
+  dataset.keep_unassociated_rgb = config.dataset.keep_unassociated_rgb;
   const TumSequence sequence = TumSequence::open(options.sequence_dir, dataset);
 
   fs::create_directories(options.out_dir);

@@ -44,6 +44,10 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
 
+  schema.addInt("tracking.local_search_keyframes", &c.local_search_keyframes, 0, 1000);
+  schema.addDouble("tracking.local_search_radius_px", &c.local_search_radius_px, 0.5, 200.0);
+  schema.addInt("tracking.local_search_max_hamming", &c.local_search_max_hamming, 1, 256);
+
   schema.addInt("tracking.reloc_keyframes", &c.reloc_keyframes, 1, 10000);
   schema.addInt("tracking.reloc_max_hamming", &c.reloc_max_hamming, 1, 256);
   schema.addDouble("tracking.reloc_ratio", &c.reloc_ratio, 0.1, 1.0);

@@ -1,8 +1,10 @@
 // Pose estimation, relocalization, keyframes and bookkeeping of Tracker::Impl.
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
+#include "dynamap/core/tracking/landmark_search.hpp"
 #include "dynamap/core/tracking/tracker_impl.hpp"
 
 namespace dynamap {
@@ -94,38 +96,83 @@ bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_
   return *mid > config_.kf_max_parallax_px;
 }
 
+// Landmarks of the newest keyframes that are no longer tracked (lost behind a walker, out of
+// view, dropped by LK) are searched for among the new keyframe's keypoints, so the keyframe is
+// tied to the old landmarks instead of starting new ones beside them.
+std::vector<int> Tracker::Impl::searchLocalMap(const OrbFeatures& features,
+                                               const std::vector<double>& depth_m,
+                                               const Eigen::Isometry3d& T_W_C,
+                                               std::vector<std::uint64_t>& ids) {
+  ids.clear();
+  if (!initialized_ || config_.local_search_keyframes <= 0 || features.keypoints.empty()) {
+    return std::vector<int>(features.keypoints.size(), -1);
+  }
+  ScopedStageTimer timer(timings_, "local_search");
+  LandmarkCandidates all;
+  map_.relocCandidates(config_.local_search_keyframes, all.ids, all.descriptors, all.points);
+  std::unordered_set<std::uint64_t> tracked;
+  for (const auto& t : tracks_) tracked.insert(t.landmark_id);
+  LandmarkCandidates c;
+  for (std::size_t i = 0; i < all.ids.size(); ++i) {
+    if (tracked.count(all.ids[i])) continue;
+    c.ids.push_back(all.ids[i]);
+    c.points.push_back(all.points[i]);
+    c.descriptors.push_back(all.descriptors.row(static_cast<int>(i)));
+  }
+  LandmarkSearchParams params;
+  params.radius_px = config_.local_search_radius_px;
+  params.max_hamming = config_.local_search_max_hamming;
+  ids = c.ids;
+  return searchByProjection(features, depth_m, c, T_W_C, camera_, params);
+}
+
 KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                                 const Eigen::Isometry3d& T_W_C,
                                                 const cv::Mat& dynamic_mask) {
   const OrbFeatures features = extractOrb(gray, dynamic_mask);
   const double max_landmark_m = std::min(config_.depth_max_m, config_.landmark_depth_max_m);
-  std::vector<int> fresh;
-  std::vector<double> fresh_depth;
+  std::vector<double> depth(features.keypoints.size());
   for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
     const cv::Point2f& p = features.keypoints[i].pt;
-    const double z = sampleDepth(frame.depth_m, p.x, p.y, config_.depth_min_m, max_landmark_m);
-    if (z <= 0.0) continue;
-    fresh.push_back(static_cast<int>(i));
-    fresh_depth.push_back(z);
+    depth[i] = sampleDepth(frame.depth_m, p.x, p.y, config_.depth_min_m, config_.depth_max_m);
+  }
+  std::vector<std::uint64_t> seen_ids;
+  const std::vector<int> seen = searchLocalMap(features, depth, T_W_C, seen_ids);
+  std::vector<int> fresh, reseen;
+  for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
+    if (seen[i] >= 0) {
+      reseen.push_back(static_cast<int>(i));
+    } else if (depth[i] > 0.0 && depth[i] <= max_landmark_m) {
+      fresh.push_back(static_cast<int>(i));
+    }
   }
   if (!initialized_ && static_cast<int>(fresh.size()) < kMinInitialLandmarks) return nullptr;
+  // A frame that starts no landmark (a colour frame with no depth frame near it, blank depth) is
+  // no keyframe: it would add nothing to the map and leave thin tracks; the next frame is asked.
+  if (fresh.empty()) return nullptr;
   // ba_lockstep: the last keyframe's BA result lands here, at a point fixed by the frames alone.
   if (config_.bundle_adjustment && config_.ba_lockstep) ba_.applyFinished();
 
   std::vector<KeyframeObservation> observations;
-  observations.reserve(tracks_.size() + fresh.size());
+  observations.reserve(tracks_.size() + fresh.size() + reseen.size());
   for (const auto& t : tracks_) {
     const double z =
         sampleDepth(frame.depth_m, t.px.x, t.px.y, config_.depth_min_m, config_.depth_max_m);
     observations.push_back({t.landmark_id, Eigen::Vector2d(t.px.x, t.px.y), z});
   }
-  for (std::size_t j = 0; j < fresh.size(); ++j) {
-    const auto i = static_cast<std::size_t>(fresh[j]);
-    const cv::Point2f& p = features.keypoints[i].pt;
-    const Eigen::Vector3d p_W = T_W_C * camera_.backProject(p.x, p.y, fresh_depth[j]);
-    const std::uint64_t id = map_.addLandmark(p_W, features.descriptors.row(fresh[j]));
+  for (const int i : reseen) {
+    const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(i)].pt;
+    const std::uint64_t id = seen_ids[static_cast<std::size_t>(seen[static_cast<std::size_t>(i)])];
     tracks_.push_back(FeatureTrack{id, p, p});
-    observations.push_back({id, Eigen::Vector2d(p.x, p.y), fresh_depth[j]});
+    observations.push_back({id, Eigen::Vector2d(p.x, p.y), depth[static_cast<std::size_t>(i)]});
+  }
+  for (const int i : fresh) {
+    const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(i)].pt;
+    const double z = depth[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d p_W = T_W_C * camera_.backProject(p.x, p.y, z);
+    const std::uint64_t id = map_.addLandmark(p_W, features.descriptors.row(i));
+    tracks_.push_back(FeatureTrack{id, p, p});
+    observations.push_back({id, Eigen::Vector2d(p.x, p.y), z});
   }
   const std::uint64_t kf_id = map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations));
   ref_kf_ = kf_id;

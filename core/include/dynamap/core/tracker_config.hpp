@@ -60,6 +60,13 @@ struct TrackerConfig {
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
   int ba_max_iterations = 10;
 
+  // --- search of the local map at keyframes ---
+  /// Landmarks of the newest keyframes that are no longer tracked are matched by projection to
+  /// a new keyframe's keypoints (and kept instead of new landmarks). 0 = off.
+  int local_search_keyframes = 5;
+  double local_search_radius_px = 10.0;  ///< keypoint within this distance of the projection
+  int local_search_max_hamming = 50;     ///< ORB descriptor distance gate
+
   // --- relocalization ---
   int reloc_keyframes = 30;    ///< newest keyframes whose landmarks are matched
   int reloc_max_hamming = 64;  ///< ORB descriptor distance gate

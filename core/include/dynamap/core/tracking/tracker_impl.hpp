@@ -60,6 +60,8 @@ class Tracker::Impl {
   bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
                   Eigen::Isometry3d& T_W_C, int& inliers);
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const;
+  std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
+                                  const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
   KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                    const Eigen::Isometry3d& T_W_C, const cv::Mat& dynamic_mask);
   OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
