@@ -4,13 +4,13 @@
 # config, and the ATE of each is printed with the dyn/clean ratio per variant and over all.
 # Offline runs are deterministic, but any change to tracking moves a single run's ATE by up to
 # ~0.2 cm; the variants show whether a change helps in general or only on one run.
-# usage: scripts/tracking_sweep.sh [--set key=value ...]   (about 3 minutes on 2 cores)
+# usage: scripts/tracking_sweep.sh [--set key=value ...]   (12 variants, about 3 minutes on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh >/dev/null
 DATA=../shared/data
 OUT=${OUT:-runs/sweep}
-STARTS=${STARTS:-"0 25 50"}
+STARTS=${STARTS:-"0 10 20 30 40 50"}
 STRIDES=${STRIDES:-"1 2"}
 rm -rf "$OUT" && mkdir -p "$OUT"
 

@@ -19,9 +19,9 @@ struct CameraSettings {
 struct DatasetSettings {
   double max_time_diff_s = 0.02;  ///< colour/depth association window
   int max_frames = 0;             ///< 0 = all frames
-  /// Colour frames with no depth frame within max_time_diff_s: false = skipped (as TUM's
-  /// associate.py pairs them), true = tracked with blank depth (every colour frame gets a pose).
-  bool keep_unassociated_rgb = false;
+  /// Colour frames with no depth frame within max_time_diff_s: true = tracked with blank depth
+  /// (every colour frame gets a pose), false = skipped (as TUM's associate.py pairs them).
+  bool keep_unassociated_rgb = true;
 };
 
 /// Everything a run is configured with. Defaults live in the section structs.

@@ -26,9 +26,9 @@ struct DatasetOptions {
   PinholeCamera camera;           ///< distortion != 0 -> frames are undistorted on load
   int max_frames = 0;             ///< 0 = all associated frames
   /// Keep colour frames that found no depth within the window (TUM sequences have a few):
-  /// they load with an all-zero depth image, so the tracker still gives them a pose. Off by
-  /// default: tracked without depth they cost accuracy (BENCHMARKS.md, tracking sweep).
-  bool keep_unassociated_rgb = false;
+  /// they load with an all-zero depth image, so the tracker still gives them a pose. Skipping
+  /// them instead gives a lower ATE on the bundled sequences (BENCHMARKS.md, tracking sweep).
+  bool keep_unassociated_rgb = true;
 };
 
 /// One associated colour + depth pair. Paths are absolute. `depth_path` is empty for a colour
