@@ -74,10 +74,8 @@ TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
   constexpr int kBlankFirst = 25, kBlankLast = 28;
   for (int i = 0; i < 45; ++i) {
     auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
-    if (i >= kBlankFirst && i <= kBlankLast) {
-      r.bgr.setTo(cv::Scalar::all(0));
-      r.depth_m.setTo(0.f);
-    }
+    // Black colour images with depth: tracking is lost and must relocalize afterwards.
+    if (i >= kBlankFirst && i <= kBlankLast) r.bgr.setTo(cv::Scalar::all(0));
     const TrackingResult res = tracker.track(makeFrame(r, i));
     if (i >= kBlankFirst && i <= kBlankLast) {
       EXPECT_EQ(res.status, FrameStatus::kLost) << "frame " << i;
@@ -103,6 +101,30 @@ TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
   EXPECT_EQ(s.tracked + s.relocalized + s.lost + s.bad_frames, s.frames);
 }
 
+TEST(SyntheticTracking, BlankFramesWithoutDepthAreLostAndTrackingResumes) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 16);
+  scene.addDefaultRoom();
+  Tracker tracker(camera, TrackerConfig{}, nullptr);
+  constexpr int kBlankFirst = 25, kBlankLast = 27;
+  for (int i = 0; i < 40; ++i) {
+    auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    const bool blank = i >= kBlankFirst && i <= kBlankLast;
+    if (blank) {  // both streams drop out: the frames are lost but the tracker keeps its state
+      r.bgr.setTo(cv::Scalar::all(0));
+      r.depth_m.setTo(0.f);
+    }
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    EXPECT_EQ(res.status, blank ? FrameStatus::kLost : FrameStatus::kTracked) << "frame " << i;
+    if (!blank) {
+      EXPECT_LT(translationError(res.T_W_C, i), 0.02) << "frame " << i;
+    }
+  }
+  const TrackerStats s = tracker.stats();
+  EXPECT_EQ(s.lost, static_cast<std::size_t>(kBlankLast - kBlankFirst + 1));
+  EXPECT_EQ(s.relocalized, 0u);
+}
+
 TEST(SyntheticTracking, FrameWithoutDepthIsPosedButMakesNoKeyframe) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 14);
@@ -121,6 +143,38 @@ TEST(SyntheticTracking, FrameWithoutDepthIsPosedButMakesNoKeyframe) {
     EXPECT_EQ(res.is_keyframe, i != kNoDepth) << "frame " << i;
     EXPECT_LT(translationError(res.T_W_C, i), 0.01) << "frame " << i;
   }
+}
+
+TEST(SyntheticTracking, FrameWithoutDepthChangesNoOtherPose) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 15);
+  scene.addDefaultRoom();
+  // One tracker sees 20 frames; the other the same frames plus a depthless frame halfway between
+  // frames 11 and 12 (as a colour frame with no depth frame near it). Offline tracking is
+  // deterministic, so every shared frame must get the very same pose.
+  Tracker plain(camera, TrackerConfig{}, nullptr);
+  Tracker with_gap(camera, TrackerConfig{}, nullptr);
+  constexpr int kGapAfter = 11;
+  for (int i = 0; i < 20; ++i) {
+    const auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    const TrackingResult a = plain.track(makeFrame(r, i));
+    const TrackingResult b = with_gap.track(makeFrame(r, i));
+    EXPECT_TRUE(a.T_W_C.isApprox(b.T_W_C, 1e-12)) << "frame " << i;
+    if (i != kGapAfter) continue;
+    auto gap = scene.render(test::smoothPath(2 * i + 1, 2 * kFrames), (i + 0.5) * kFramePeriodS);
+    gap.depth_m.setTo(0.f);
+    RgbdFrame f = makeFrame(gap, i);
+    f.timestamp_s = (i + 0.5) * kFramePeriodS;
+    const TrackingResult g = with_gap.track(f);
+    EXPECT_EQ(g.status, FrameStatus::kTracked);
+    EXPECT_FALSE(g.is_keyframe);
+    const Eigen::Isometry3d truth =
+        test::smoothPath(0, kFrames).inverse() * test::smoothPath(2 * i + 1, 2 * kFrames);
+    EXPECT_LT((g.T_W_C.translation() - truth.translation()).norm(), 0.01);
+  }
+  plain.finish();
+  with_gap.finish();
+  EXPECT_EQ(with_gap.finalTrajectory().size(), plain.finalTrajectory().size() + 1);
 }
 
 /// Flags every match and masks every pixel of the moving box (from the renderer's mask).

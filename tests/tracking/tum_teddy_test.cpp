@@ -65,7 +65,7 @@ struct TeddyRun {
   TrackerStats stats;
 };
 
-/// Tracks every frame (frames in [blank_first, blank_first + blank_count) blacked out, depth 0)
+/// Tracks every frame (colour of frames in [blank_first, blank_first + blank_count) blacked out)
 /// and aligns the final trajectory to the ground truth (Horn, no scale).
 TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
   const auto& frames = teddyFrames();
@@ -78,7 +78,6 @@ TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
     if (i >= blank_first && i < blank_first + blank_count) {
       RgbdFrame blank = f;
       blank.bgr = cv::Mat::zeros(f.bgr.size(), f.bgr.type());
-      blank.depth_m = cv::Mat::zeros(f.depth_m.size(), f.depth_m.type());
       tracker.track(blank);
     } else {
       tracker.track(f);

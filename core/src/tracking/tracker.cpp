@@ -38,6 +38,7 @@ Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
 // The per-frame step: match -> dynamic filter -> pose -> (relocalize) -> keyframe.
 TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   ScopedStageTimer total(timings_, "tracking");
+  if (frame.depth_m.empty() || cv::countNonZero(frame.depth_m) == 0) return poseWithoutDepth(frame);
   if (filter_) filter_->beginFrame(frame);
   const cv::Mat gray = toGray(frame.bgr, camera_);
   const Eigen::Isometry3d T_W_C_pred = predictPose();
@@ -100,6 +101,35 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   refillProbes(gray);
   // A grey input is used as is: copy it so the caller may reuse its buffer.
   prev_gray_ = gray.data == frame.bgr.data ? gray.clone() : gray;
+  return result;
+}
+
+// A frame without depth (a colour frame with no depth frame near it, a blank depth image) is
+// posed by LK + PnP from the last frame's tracks but changes nothing: no motion filter, no
+// keyframe, no new tracks or velocity. The next frame is matched against the last frame with
+// depth, as if this one were not there, so keeping such frames costs the other poses nothing.
+TrackingResult Tracker::Impl::poseWithoutDepth(const RgbdFrame& frame) {
+  TrackingResult result;
+  result.status = FrameStatus::kLost;
+  result.T_W_C = T_W_last_;
+  if (initialized_ && last_tracked_ && !tracks_.empty()) {
+    const std::vector<FeatureTrack> saved = tracks_;
+    const Eigen::Isometry3d T_W_C_pred = predictPose();
+    FeatureMatches matches;
+    {
+      ScopedStageTimer timer(timings_, "lk");
+      matchFeatures(lk_.buildPyramid(toGray(frame.bgr, camera_)), T_W_C_pred, matches);
+    }
+    Eigen::Isometry3d T_W_C = T_W_C_pred;
+    if (estimatePose(frame, T_W_C, result.inliers)) {
+      result.status = FrameStatus::kTracked;
+      result.T_W_C = T_W_C;
+    }
+    result.tracked_features = static_cast<int>(tracks_.size());
+    tracks_ = saved;
+  }
+  record(frame.timestamp_s, result.status, result.T_W_C);
+  countStatus(result.status, false);
   return result;
 }
 

@@ -47,6 +47,7 @@ class Tracker::Impl {
   LocalBundleAdjuster ba_;
 
  private:
+  TrackingResult poseWithoutDepth(const RgbdFrame& frame);
   Eigen::Isometry3d predictPose() const;
   void matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d& T_W_C_pred,
                      FeatureMatches& matches);
