@@ -19,8 +19,8 @@ struct CameraSettings {
 struct DatasetSettings {
   double max_time_diff_s = 0.02;  ///< colour/depth association window
   int max_frames = 0;             ///< 0 = all frames
-  /// Colour frames with no depth frame within max_time_diff_s: true = tracked with blank depth
-  /// (every colour frame gets a pose), false = skipped (as TUM's associate.py pairs them).
+  /// Colour frames with no depth frame within max_time_diff_s: true = posed without depth, no
+  /// other pose changes (every colour frame gets a pose), false = skipped (as TUM's associate.py).
   bool keep_unassociated_rgb = true;
 };
 

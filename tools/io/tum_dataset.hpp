@@ -26,8 +26,8 @@ struct DatasetOptions {
   PinholeCamera camera;           ///< distortion != 0 -> frames are undistorted on load
   int max_frames = 0;             ///< 0 = all associated frames
   /// Keep colour frames that found no depth within the window (TUM sequences have a few):
-  /// they load with an all-zero depth image, so the tracker still gives them a pose. Skipping
-  /// them instead gives a lower ATE on the bundled sequences (BENCHMARKS.md, tracking sweep).
+  /// they load with an all-zero depth image; the tracker poses them without changing its state,
+  /// so every other pose is the same as when they are skipped.
   bool keep_unassociated_rgb = true;
 };
 

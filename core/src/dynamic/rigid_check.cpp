@@ -161,9 +161,9 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
     auto& c = cells[{cvFloor(cur_px[i].x / bucket), cvFloor(cur_px[i].y / bucket)}];
     if (c++ < 2) fit.push_back(static_cast<int>(i));
   }
-  // Far points only pin the rotation of a fit made of measured depth: without enough depth (a
-  // colour frame with no depth frame near it, a blank depth image) every point would look "far"
-  // and the fit would treat a near scene as if it were 12 m away.
+  // Far points only pin the rotation of a fit made of measured depth: with too little depth
+  // (mostly invalid pixels) every point would look "far" and the fit would treat a near scene as
+  // if it were 12 m away.
   const auto measured = std::count_if(fit.begin(), fit.end(), [&](int i) { return z[i] > 0.f; });
   if (measured < kMinFitPoints) return checkEpipolar(prev_px, cur_px, o);
 

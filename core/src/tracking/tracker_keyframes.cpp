@@ -147,9 +147,6 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     }
   }
   if (!initialized_ && static_cast<int>(fresh.size()) < kMinInitialLandmarks) return nullptr;
-  // A frame that starts no landmark (a colour frame with no depth frame near it, blank depth) is
-  // no keyframe: it would add nothing to the map and leave thin tracks; the next frame is asked.
-  if (fresh.empty()) return nullptr;
   // ba_lockstep: the last keyframe's BA result lands here, at a point fixed by the frames alone.
   if (config_.bundle_adjustment && config_.ba_lockstep) ba_.applyFinished();
 
