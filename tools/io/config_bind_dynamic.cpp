@@ -46,6 +46,8 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addInt("dynamic.min_object_points", &c.min_object_points, 1, 100000);
   schema.addInt("dynamic.min_dynamic_points", &c.min_dynamic_points, 1, 100000);
   schema.addDouble("dynamic.evidence_smoothing", &c.evidence_smoothing, 0.0, 0.99);
+  schema.addInt("dynamic.static_confirm_frames", &c.static_confirm_frames, 0, 100000);
+  schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);
   schema.addDouble("dynamic.static_carve_radius_px", &c.static_carve_radius_px, 0.0, 1000.0);

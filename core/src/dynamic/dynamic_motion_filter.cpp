@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include <opencv2/calib3d.hpp>
+
 namespace dynamap {
 
 namespace {
@@ -191,11 +193,15 @@ void DynamicMotionFilter::takeDetections(bool wait) {
   record("detector_wait", msSince(start));
 }
 
-std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* frame) {
+std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* frame,
+                                                              const FeatureMatches& m) {
   if (!worker_ || frame == nullptr || frame->bgr.empty()) return {};
   const bool begun = frame_no_ >= 0 && frame->timestamp_s == begun_stamp_;
   const bool sync = !config_.detector_async;
-  if (!lockstep()) takeDetections(sync);  // lockstep: beginFrame() took them
+  // The very first frame has no earlier detections to use: it waits for its own, so that the
+  // first keyframe (the map's start) never takes a person for background.
+  const bool first = begun && latest_.frame_no < 0;
+  if (!lockstep() || first) takeDetections(sync || first);  // lockstep: beginFrame() took them
   if (sync) {  // the frame's own detections (beginFrame() not called for it: detect now)
     if (begun && latest_.frame_no == frame_no_) return latest_.detections;
     return worker_->runNow(frame->bgr);
@@ -203,10 +209,16 @@ std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* f
   const long age = frame_no_ - latest_.frame_no;
   if (latest_.frame_no < 0 || !begun || age > config_.detector_max_age_frames) return {};
   record("detector_age", 1000.0 * (frame->timestamp_s - latest_.stamp));
-  // A walker moves a few pixels per frame: grow old boxes; fusion cuts them by depth again.
+  // Older detections: each box moves with the median flow of the matches inside it (a walker
+  // close to the camera moves tens of pixels a frame) and grows a little per frame of age;
+  // fusion cuts them by depth again.
   std::vector<Detection> dets = latest_.detections;
   const auto grow = static_cast<float>(config_.stale_box_growth_px * static_cast<double>(age));
   for (auto& d : dets) {
+    cv::Point2f flow;
+    if (age > 0 && medianFlowIn(d.box, m.prev_px, m.cur_px, &flow)) {
+      d.box += flow * static_cast<float>(age);
+    }
     d.box =
         cv::Rect2f(d.box.x - grow, d.box.y - grow, d.box.width + 2 * grow, d.box.height + 2 * grow);
   }
@@ -214,7 +226,9 @@ std::vector<Detection> DynamicMotionFilter::currentDetections(const RgbdFrame* f
 }
 
 EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
-                                                  const std::vector<Detection>& dets) {
+                                                  const std::vector<Detection>& dets,
+                                                  const RigidMotion* prior, bool* background_fit) {
+  *background_fit = false;
   EpipolarOptions eo;
   eo.threshold_px = config_.epipolar_threshold_px;
   eo.min_matches = config_.min_matches;
@@ -225,14 +239,14 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
   eo.rigid_epipolar_threshold_px = config_.rigid_epipolar_threshold_px;
   eo.bucket_px = config_.bucket_px;
   eo.ransac_iterations = config_.ransac_iterations;
-  if (config_.geometric_check == "epipolar" || depth.empty()) {
-    return checkEpipolar(m.prev_px, m.cur_px, eo);
-  }
-  // Matches on last frame's moving regions and inside high-dynamic boxes count less when
-  // voting for the camera motion (a large textured mover can otherwise out-vote a nearly
-  // planar background); they are never excluded, so a wrong mask cannot lock itself in.
+  // Matches on last frame's moving regions and inside high-dynamic boxes count less (by default
+  // nothing) when voting for the camera motion: people who fill the frame would otherwise make
+  // the camera follow them, and then the check measures nothing. A wrong mask cannot lock
+  // itself in: an object's points are still checked against the background's motion, and
+  // fusion keeps an object that stays still there.
   const std::size_t n = m.cur_px.size();
   std::vector<float> weight(n, 1.f);
+  int background = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (inMask(prev_mask_, m.cur_px[i])) weight[i] *= static_cast<float>(config_.masked_fit_weight);
     for (const auto& d : dets) {
@@ -241,19 +255,47 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
         break;
       }
     }
+    background += weight[i] == 1.f ? 1 : 0;
   }
-  return checkRigidMotion(m.prev_px, m.cur_px, depth, K_, weight, eo, &motion_);
+  if (config_.geometric_check == "epipolar" || depth.empty()) {
+    // The paper's check: fundamental matrix (or homography at low parallax) of the background.
+    std::vector<std::uint8_t> subset(n);
+    for (std::size_t i = 0; i < n; ++i) subset[i] = weight[i] == 1.f ? 1 : 0;
+    EpipolarResult r = checkEpipolar(m.prev_px, m.cur_px, eo, subset);
+    *background_fit = r.model != EpipolarModel::kNone;
+    return r;
+  }
+  EpipolarResult r =
+      checkRigidMotion(m.prev_px, m.cur_px, depth, K_, weight, eo, &motion_, prior);
+  *background_fit =
+      r.model == EpipolarModel::kRigid && (r.from_prior || background >= config_.min_matches);
+  return r;
 }
 
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   static const FeatureMatches kNoMatches;
   const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
-  auto dets = currentDetections(input.frame);
+  auto dets = currentDetections(input.frame, m);
   const cv::Mat frame_depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
 
   auto start = Clock::now();
   EpipolarResult epi;
-  if (mode_ != FusionMode::kDetector) epi = checkGeometry(m, frame_depth, dets);
+  FusionEvidence evidence;
+  if (mode_ != FusionMode::kDetector) {
+    RigidMotion prior;
+    if (input.has_prior) {
+      // X_prev = R X_cur + t, as checkRigidMotion() writes motions.
+      const Eigen::Matrix3d R = input.T_prev_cur.rotation();
+      const cv::Matx33d Rm(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1),
+                           R(2, 2));
+      cv::Rodrigues(Rm, prior.rvec);
+      const Eigen::Vector3d t = input.T_prev_cur.translation();
+      prior.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+      prior.valid = true;
+    }
+    epi = checkGeometry(m, frame_depth, dets, prior.valid ? &prior : nullptr,
+                        &evidence.background_fit);
+  }
   epi.is_dynamic.resize(m.cur_px.size(), 0);
   record("epipolar", msSince(start));
 
@@ -263,8 +305,9 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
     depth = cv::Mat::zeros(size, CV_32FC1);
   }
-  const bool informative = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
-  FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, informative);
+  evidence.flags_valid = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
+  evidence.prev_points = m.prev_px;
+  FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
   MotionFilterOutput out;
   out.match_is_dynamic.resize(m.cur_px.size(), 0);
   for (std::size_t i = 0; i < m.cur_px.size(); ++i) {

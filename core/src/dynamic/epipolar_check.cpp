@@ -49,14 +49,33 @@ double symmetricEpipolarDistance(const cv::Matx33d& F, const cv::Point2f& p1,
 }
 
 EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
-                             const std::vector<cv::Point2f>& cur_px, const EpipolarOptions& o) {
+                             const std::vector<cv::Point2f>& cur_px, const EpipolarOptions& o,
+                             const std::vector<std::uint8_t>& fit_subset) {
   EpipolarResult r;
   const std::size_t n = std::min(prev_px.size(), cur_px.size());
   r.residual_px.assign(n, 0.f);
   r.is_dynamic.assign(n, 0);
   if (static_cast<int>(n) < std::max(o.min_matches, 8)) return r;
-  const std::vector<cv::Point2f> p1(prev_px.begin(), prev_px.begin() + n);
-  const std::vector<cv::Point2f> p2(cur_px.begin(), cur_px.begin() + n);
+  std::vector<cv::Point2f> p1(prev_px.begin(), prev_px.begin() + n);
+  std::vector<cv::Point2f> p2(cur_px.begin(), cur_px.begin() + n);
+  if (fit_subset.size() == n) {  // the models are fitted on the subset, every match is checked
+    const std::vector<cv::Point2f> all1 = p1, all2 = p2;
+    p1 = select(all1, fit_subset), p2 = select(all2, fit_subset);
+    if (static_cast<int>(p1.size()) < std::max(o.min_matches, 8)) return r;
+    EpipolarResult fit = checkEpipolar(p1, p2, o);
+    if (fit.model == EpipolarModel::kNone) return r;
+    r.model = fit.model;
+    r.F = fit.F;
+    for (std::size_t i = 0; i < n; ++i) {
+      r.residual_px[i] = static_cast<float>(
+          fit.model == EpipolarModel::kHomography
+              ? transferError(cv::Matx33d(fit.H), all1[i], all2[i])
+              : symmetricEpipolarDistance(cv::Matx33d(fit.F), all1[i], all2[i]));
+      const double thr = (fit.model == EpipolarModel::kHomography ? 2.0 : 1.0) * o.threshold_px;
+      r.is_dynamic[i] = r.residual_px[i] > thr;
+    }
+    return r;
+  }
   if (medianFlow(p1, p2) < o.min_parallax_px) return r;
 
   std::vector<uchar> f_inl, h_inl;
@@ -80,6 +99,7 @@ EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
     H = cv::findHomography(select(p1, h_inl), select(p2, h_inl), 0);
     if (H.empty()) return r;
     r.model = EpipolarModel::kHomography;
+    H.convertTo(r.H, CV_64F);
     const cv::Matx33d Hm(H);
     for (std::size_t i = 0; i < n; ++i)
       r.residual_px[i] = static_cast<float>(transferError(Hm, p1[i], p2[i]));

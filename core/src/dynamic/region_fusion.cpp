@@ -11,8 +11,9 @@ namespace {
 
 constexpr double kBinM = 0.1;
 constexpr int kStaticShareInverse = 10;  ///< < 1/10 of an object's points dynamic: static now
-constexpr int kStaticMinPoints = 12;     ///< ... with at least this many points
+constexpr int kStaticMinPoints = 5;      ///< ... with at least this many points
 constexpr int kBins = 100;               // 0..10 m
+constexpr float kMatchIou = 0.3f;        ///< a detection continues a track above this IoU
 
 /// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few.
 double depthMode(const cv::Mat& roi) {
@@ -140,85 +141,133 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
 RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classes)
     : config_(config), classes_(classes) {}
 
-void RegionFusion::decideObject(ObjectDecision& d, std::vector<Track>& next) {
+ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* prev,
+                                       const FusionEvidence& ev) const {
   // Evidence: class prior x share of dynamic points on the object's own pixels.
-  const bool observed = evidence_valid_ && d.points >= config_.min_object_points;
+  const bool observed = ev.flags_valid && d.points >= config_.min_object_points;
   const double evidence = observed ? d.weight * d.dynamic_points / d.points : 0.0;
   d.moving_now = observed && d.dynamic_points >= config_.min_dynamic_points &&
                  evidence >= config_.moving_ratio;
-  const Track* prev = nullptr;
-  float best_iou = 0.3f;
-  for (const auto& t : tracks_) {
-    const float o = iou(t.box, d.detection.box);
-    if (t.class_id == d.detection.class_id && o > best_iou) best_iou = o, prev = &t;
-  }
-  // Temporal hysteresis: the evidence is smoothed over frames; an object turns moving when the
-  // smoothed evidence reaches moving_ratio (with enough dynamic points now) and stays moving
-  // until it falls below half of it. Unobserved frames keep the previous state.
+  const bool quiet = observed && d.points >= kStaticMinPoints &&
+                     d.dynamic_points * kStaticShareInverse < d.points;
+  ObjectTrack t;
+  t.box = d.detection.box;
+  t.class_id = d.detection.class_id;
   const double a = config_.evidence_smoothing;
-  double score = evidence;
-  if (prev != nullptr) score = observed ? a * prev->score + (1.0 - a) * evidence : prev->score;
+  t.score = evidence;
+  if (prev != nullptr) t.score = observed ? a * prev->score + (1.0 - a) * evidence : prev->score;
+  // Temporal hysteresis: the smoothed evidence must reach moving_ratio (with enough dynamic
+  // points now) to turn the object moving; it stays moving until it falls below half of it.
+  // Clear static evidence counts twice (a faster release). Unobserved frames keep the state.
   const bool was_moving = prev != nullptr && prev->moving;
-  d.moving = was_moving ? score >= 0.5 * config_.moving_ratio
-                        : (d.moving_now && score >= config_.moving_ratio);
-  // Clear static evidence now counts twice (a faster release): boxes are associated by IoU,
-  // and a standing person next to a walker can inherit the walker's track. A single quiet
-  // frame still holds a moving object.
-  if (prev != nullptr && d.points >= kStaticMinPoints &&
-      d.dynamic_points * kStaticShareInverse < d.points) {
-    score = a * score + (1.0 - a) * evidence;
-    d.moving = was_moving && score >= 0.5 * config_.moving_ratio;
+  t.moving = was_moving ? t.score >= 0.5 * config_.moving_ratio
+                        : (d.moving_now && t.score >= config_.moving_ratio);
+  if (prev != nullptr && quiet) {
+    t.score = a * t.score + (1.0 - a) * evidence;
+    t.moving = was_moving && t.score >= 0.5 * config_.moving_ratio;
   }
-  next.push_back(Track{d.detection.box, d.detection.class_id, score, d.moving});
+  if (classes_.isHighDynamic(d.detection.class_id)) {
+    // Keeping a person takes evidence gathered over time, measured against a camera motion
+    // fitted without it; one frame of clear motion removes it again.
+    const int before = prev != nullptr ? prev->quiet_frames : 0;
+    t.quiet_frames = d.moving_now ? 0 : before + (quiet && ev.background_fit ? 1 : 0);
+    t.moving = t.moving || t.quiet_frames < config_.static_confirm_frames;
+  }
+  d.moving = t.moving;
+  d.quiet_frames = t.quiet_frames;
+  return t;
+}
+
+void RegionFusion::propagateTracks(const std::vector<cv::Point2f>& points,
+                                   const FusionEvidence& evidence) {
+  if (evidence.prev_points.size() != points.size()) return;
+  for (auto& t : tracks_) {
+    cv::Point2f flow;
+    if (medianFlowIn(t.box, evidence.prev_points, points, &flow)) t.box += flow;
+  }
+}
+
+cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box,
+                                   ObjectDecision& d, const std::vector<cv::Point2f>& points,
+                                   const std::vector<std::uint8_t>& dyn) const {
+  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m);
+  if (region.empty()) {
+    region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+    region(box).setTo(255);
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!inside(region, points[i])) continue;
+    ++d.points;
+    if (dyn[i]) ++d.dynamic_points;
+  }
+  return region;
+}
+
+void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region,
+                               const cv::Rect& box, const std::vector<cv::Point2f>& points,
+                               const std::vector<std::uint8_t>& dyn, FusionResult& result) const {
+  if (d.moving && mode == FusionMode::kBoth) {
+    carveStatic(region, box, points, dyn, config_.static_carve_radius_px);
+  }
+  (d.moving ? result.mask : result.static_objects) |= region;
+  result.objects.push_back(d);
 }
 
 FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const std::vector<cv::Point2f>& points,
                                 const std::vector<std::uint8_t>& dyn,
-                                const std::vector<Detection>& detections, bool evidence_valid) {
-  evidence_valid_ = evidence_valid;
+                                const std::vector<Detection>& detections,
+                                const FusionEvidence& evidence) {
   FusionResult result;
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.static_objects = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
-  std::vector<Track> next;
-  for (const auto& det : detections) {
-    if (mode == FusionMode::kGeometry) break;
-    ObjectDecision d;
-    d.detection = det;
-    d.weight = classes_.weight(det.class_id);
-    if (d.weight <= 0.0) continue;
-    if (mode == FusionMode::kDetector && !classes_.isHighDynamic(det.class_id)) continue;
-    const cv::Rect box = clampRect(det.box, depth_m.size());
-    if (box.area() <= 0) continue;
-    cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m);
-    if (region.empty()) {
-      region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
-      region(box).setTo(255);
+  std::vector<ObjectTrack> next;
+  if (mode != FusionMode::kGeometry) {
+    propagateTracks(points, evidence);
+    const std::vector<int> track_of = associateDetections(detections, tracks_, kMatchIou);
+    std::vector<bool> matched(tracks_.size(), false);
+    for (std::size_t k = 0; k < detections.size(); ++k) {
+      ObjectDecision d;
+      d.detection = detections[k];
+      d.weight = classes_.weight(d.detection.class_id);
+      if (d.weight <= 0.0) continue;
+      if (mode == FusionMode::kDetector && !classes_.isHighDynamic(d.detection.class_id)) continue;
+      const cv::Rect box = clampRect(d.detection.box, depth_m.size());
+      if (box.area() <= 0) continue;
+      cv::Mat region = objectRegion(depth_m, box, d, points, dyn);
+      if (mode == FusionMode::kDetector) {
+        d.moving_now = d.moving = true;
+      } else {
+        const ObjectTrack* prev = track_of[k] >= 0 ? &tracks_[track_of[k]] : nullptr;
+        if (prev != nullptr) matched[track_of[k]] = true;
+        next.push_back(decideObject(d, prev, evidence));
+      }
+      claimed |= region;
+      applyObject(mode, d, region, box, points, dyn, result);
     }
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (!inside(region, points[i])) continue;
-      ++d.points;
-      if (dyn[i]) ++d.dynamic_points;
+    // Objects the detector did not report in this frame: a person seen a moment ago keeps its
+    // mask (and its evidence) for a few frames, its box moved with the flow.
+    for (std::size_t t = 0; t < tracks_.size() && mode == FusionMode::kBoth; ++t) {
+      const ObjectTrack& track = tracks_[t];
+      const cv::Rect box = clampRect(track.box, depth_m.size());
+      if (matched[t] || track.missed >= config_.track_max_missed_frames ||
+          box.area() * 4 < track.box.area()) {
+        continue;
+      }
+      ObjectDecision d;
+      d.detection = Detection{track.box, track.class_id, 0.f};
+      d.weight = classes_.weight(track.class_id);
+      d.carried = true;
+      cv::Mat region = objectRegion(depth_m, box, d, points, dyn);
+      next.push_back(decideObject(d, &track, evidence));
+      next.back().missed = track.missed + 1;
+      claimed |= region;
+      applyObject(mode, d, region, box, points, dyn, result);
     }
-    if (mode == FusionMode::kDetector) {
-      d.moving_now = d.moving = true;
-    } else {
-      decideObject(d, next);
-    }
-    claimed |= region;
-    if (d.moving && mode == FusionMode::kBoth) {
-      carveStatic(region, box, points, dyn, config_.static_carve_radius_px);
-    }
-    if (d.moving) {
-      result.mask |= region;
-    } else {
-      result.static_objects |= region;
-    }
-    result.objects.push_back(d);
   }
   tracks_ = std::move(next);
-  if (mode != FusionMode::kDetector && evidence_valid) {
+  if (mode != FusionMode::kDetector && evidence.flags_valid) {
     result.clusters = growClusters(depth_m, points, dyn, claimed, result.mask);
   }
   if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {

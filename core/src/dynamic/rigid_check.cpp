@@ -13,6 +13,7 @@ namespace {
 constexpr int kMinFitPoints = 12;
 constexpr float kFarDepthM = 12.f;
 constexpr int kMinIterations = 120;
+constexpr int kPriorMinShareInverse = 5;  ///< a prior needs 1/5 of the fit matches as inliers
 
 /// Depth at `p` if valid and not on a depth edge (5x5 range < 5 % of the depth), else 0.
 float stableDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
@@ -60,6 +61,7 @@ struct PoseFit {
   cv::Mat rvec, tvec;
   std::vector<int> inliers;  ///< indices into the fit arrays
   bool ok = false;
+  bool from_prior = false;
 };
 
 /// Points within `threshold_px` of the pose's reprojection and their summed weight.
@@ -78,16 +80,45 @@ double scorePose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2
   return score;
 }
 
+/// Levenberg-Marquardt on the inliers of f's pose (twice).
+PoseFit refinePose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
+                   const std::vector<float>& w, const cv::Matx33d& K, double threshold_px,
+                   PoseFit f) {
+  for (int round = 0; round < 2; ++round) {
+    scorePose(X, p, w, K, f.rvec, f.tvec, threshold_px, &f.inliers);
+    if (static_cast<int>(f.inliers.size()) < kMinFitPoints / 2) return f;
+    std::vector<cv::Point3f> ix;
+    std::vector<cv::Point2f> ip;
+    for (int k : f.inliers) ix.push_back(X[k]), ip.push_back(p[k]);
+    cv::solvePnPRefineLM(ix, ip, K, cv::noArray(), f.rvec, f.tvec);
+  }
+  f.ok = true;
+  return f;
+}
+
 /// RANSAC over minimal 4-point (AP3P) samples scored by the summed weight of the inliers (so
 /// matches on likely movers count less), then Levenberg-Marquardt on the inliers (twice).
 /// Adaptive number of iterations (at least kMinIterations, at most `iterations`).
 /// Deterministic (fixed seed).
 PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f>& p,
                 const std::vector<float>& w, const cv::Matx33d& K, double threshold_px,
-                int iterations) {
+                int iterations, const RigidMotion* prior) {
   PoseFit f;
   const int n = static_cast<int>(X.size());
   if (n < kMinFitPoints) return f;
+  if (prior != nullptr && prior->valid) {
+    // The tracker's map-based motion: taken (and refined on its inliers) when enough of the
+    // matches agree with it, whatever a larger moving majority would vote for.
+    f.rvec = cv::Mat(prior->rvec).clone();
+    f.tvec = cv::Mat(prior->tvec).clone();
+    std::vector<int> inl;
+    scorePose(X, p, w, K, f.rvec, f.tvec, threshold_px, &inl);
+    if (static_cast<int>(inl.size()) >= std::max(kMinFitPoints, n / kPriorMinShareInverse)) {
+      f.from_prior = true;
+      return refinePose(X, p, w, K, threshold_px, f);
+    }
+    f.rvec.release(), f.tvec.release();
+  }
   cv::RNG rng(0x5eed);
   double best = 0.0;
   int needed = iterations;
@@ -114,16 +145,7 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
     if (it + 1 >= std::max(kMinIterations, needed)) break;
   }
   if (f.rvec.empty()) return f;
-  for (int round = 0; round < 2; ++round) {
-    scorePose(X, p, w, K, f.rvec, f.tvec, threshold_px, &f.inliers);
-    if (static_cast<int>(f.inliers.size()) < kMinFitPoints / 2) return f;
-    std::vector<cv::Point3f> ix;
-    std::vector<cv::Point2f> ip;
-    for (int k : f.inliers) ix.push_back(X[k]), ip.push_back(p[k]);
-    cv::solvePnPRefineLM(ix, ip, K, cv::noArray(), f.rvec, f.tvec);
-  }
-  f.ok = true;
-  return f;
+  return refinePose(X, p, w, K, threshold_px, f);
 }
 
 }  // namespace
@@ -131,7 +153,8 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
 EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
                                 const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
                                 const cv::Vec4d& K, const std::vector<float>& fit_weight,
-                                const EpipolarOptions& o, RigidMotion* estimated) {
+                                const EpipolarOptions& o, RigidMotion* estimated,
+                                const RigidMotion* prior) {
   if (estimated != nullptr) *estimated = RigidMotion{};
   const std::size_t n = std::min(prev_px.size(), cur_px.size());
   EpipolarResult r;
@@ -176,7 +199,7 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
   }
   const cv::Matx33d Km(K[0], 0, K[2], 0, K[1], K[3], 0, 0, 1);
   const double fit_thr = 0.5 * o.reprojection_threshold_px;
-  PoseFit best = fitPose(fx, fp, fw, Km, fit_thr, o.ransac_iterations);
+  PoseFit best = fitPose(fx, fp, fw, Km, fit_thr, o.ransac_iterations, prior);
   if (!best.ok) return checkEpipolar(prev_px, cur_px, o);
   const cv::Mat& rvec = best.rvec;
   const cv::Mat& tvec = best.tvec;
@@ -192,6 +215,7 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
   const cv::Matx33d Kinv = Km.inv();
   const cv::Matx33d F = Kinv.t() * tx * Rc * Kinv;
   r.model = EpipolarModel::kRigid;
+  r.from_prior = best.from_prior;
   r.F = cv::Mat(F).clone();
   std::vector<cv::Point2f> proj;
   cv::projectPoints(X, rvec, tvec, Km, cv::noArray(), proj);

@@ -20,6 +20,7 @@ std::uint64_t LocalMap::addKeyframe(double timestamp_s, const Eigen::Isometry3d&
   kf.timestamp_s = timestamp_s;
   kf.T_W_C = T_W_C;
   kf.observations = std::move(observations);
+  for (const auto& o : kf.observations) ++landmarks_[o.landmark_id].keyframes;
   keyframes_.push_back(std::move(kf));
   return keyframes_.back().id;
 }
@@ -51,6 +52,12 @@ void LocalMap::landmarkPositions(const std::vector<std::uint64_t>& ids,
   std::lock_guard<std::mutex> lock(mutex_);
   out.resize(ids.size());
   for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].p_W;
+}
+
+void LocalMap::keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector<int>& out) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  out.resize(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].keyframes;
 }
 
 BaWindow LocalMap::snapshotWindow(int window, int fixed) const {

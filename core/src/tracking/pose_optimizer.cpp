@@ -1,6 +1,9 @@
 #include "dynamap/core/tracking/pose_optimizer.hpp"
 
+#include <cmath>
 #include <memory>
+
+#include <ceres/rotation.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -21,6 +24,36 @@ RgbdResidual makeResidual(const PinholeCamera& camera, const TrackerConfig& conf
   return RgbdResidual(camera, c.px, config.use_depth_residual ? c.depth_m : 0.0,
                       1.0 / (config.pixel_sigma_px * c.sigma_scale), inv_sigma_z);
 }
+
+/// Holds a pose block near a predicted one: rotation vector difference / sigma_rad and camera
+/// centre difference / sigma_m (the centre, not T_C_W's translation, which a small rotation
+/// far from the world origin moves a lot).
+struct MotionPriorResidual {
+  MotionPriorResidual(const double* predicted, double inv_sigma_rad, double inv_sigma_m)
+      : inv_sigma_rad_(inv_sigma_rad), inv_sigma_m_(inv_sigma_m) {
+    for (int i = 0; i < 6; ++i) pred_[i] = predicted[i];
+    centre(pred_, centre_);
+  }
+  template <typename T>
+  static void centre(const T* p, T* c) {
+    const T neg_aa[3] = {-p[0], -p[1], -p[2]};
+    const T neg_t[3] = {-p[3], -p[4], -p[5]};
+    ceres::AngleAxisRotatePoint(neg_aa, neg_t, c);  // c = -R^T t
+  }
+  template <typename T>
+  bool operator()(const T* p, T* r) const {
+    T c[3];
+    centre(p, c);
+    for (int i = 0; i < 3; ++i) {
+      r[i] = (p[i] - T(pred_[i])) * T(inv_sigma_rad_);
+      r[3 + i] = (c[i] - T(centre_[i])) * T(inv_sigma_m_);
+    }
+    return true;
+  }
+  double pred_[6];
+  double centre_[3];
+  double inv_sigma_rad_, inv_sigma_m_;
+};
 
 }  // namespace
 
@@ -81,9 +114,13 @@ bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::I
 }
 
 int PoseOptimizer::refine(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
-                          std::vector<std::uint8_t>& inlier) const {
-  double pose[6];
+                          std::vector<std::uint8_t>& inlier,
+                          const Eigen::Isometry3d* predicted) const {
+  double pose[6], pred[6];
   toPoseBlock(T_W_C, pose);
+  const bool use_prior = predicted != nullptr && config_.motion_prior_sigma_m > 0.0 &&
+                         config_.motion_prior_sigma_deg > 0.0;
+  if (use_prior) toPoseBlock(*predicted, pred);
   ceres::HuberLoss loss(config_.robust_loss_sigma);
   int count = 0;
   for (int round = 0; round < 2; ++round) {
@@ -97,6 +134,13 @@ int PoseOptimizer::refine(const std::vector<PoseCorrespondence>& corr, Eigen::Is
           new RgbdPoseOnlyResidual(makeResidual(camera_, config_, corr[i]), corr[i].p_W));
       problem.AddResidualBlock(cost, &loss, pose);
       ++used;
+    }
+    if (use_prior && used > 0) {
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 6>(new MotionPriorResidual(
+              pred, 1.0 / (config_.motion_prior_sigma_deg * M_PI / 180.0),
+              1.0 / config_.motion_prior_sigma_m)),
+          nullptr, pose);
     }
     if (used < 4) break;
     ceres::Solver::Options options;
@@ -136,7 +180,7 @@ PoseEstimate PoseOptimizer::estimate(const std::vector<PoseCorrespondence>& corr
     }
   }
   ScopedStageTimer timer(timings, "pose_refine");
-  est.inliers = refine(corr, est.T_W_C, est.inlier);
+  est.inliers = refine(corr, est.T_W_C, est.inlier, &T_W_C_guess);
   est.ok = est.inliers >= config_.min_inliers;
   return est;
 }

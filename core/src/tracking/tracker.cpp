@@ -51,7 +51,10 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     trackProbes(pyramid, matches);
   }
   TrackingResult result;
-  const MotionFilterOutput filtered = runMotionFilter(frame, gray, matches);
+  Eigen::Isometry3d T_W_C_prior = T_W_C_pred;
+  const bool has_prior = filter_ && priorPose(frame, T_W_C_prior);
+  const MotionFilterOutput filtered =
+      runMotionFilter(frame, gray, matches, has_prior ? &T_W_C_prior : nullptr);
   result.dynamic_mask = filtered.dynamic_mask;
   result.dynamic_matches = dropDynamic(matches, filtered);
   result.tracked_features = static_cast<int>(tracks_.size());
@@ -228,10 +231,15 @@ void Tracker::Impl::refillProbes(const cv::Mat& gray) {
 }
 
 MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
-                                                  const FeatureMatches& matches) {
+                                                  const FeatureMatches& matches,
+                                                  const Eigen::Isometry3d* T_W_C_prior) {
   if (!filter_) return {};
   ScopedStageTimer timer(timings_, "motion_filter");
   MotionFilterInput input;
+  if (T_W_C_prior != nullptr) {
+    input.has_prior = true;
+    input.T_prev_cur = T_W_last_.inverse() * *T_W_C_prior;
+  }
   input.frame = &frame;
   input.prev_gray = prev_gray_.empty() ? &gray : &prev_gray_;
   input.cur_gray = &gray;

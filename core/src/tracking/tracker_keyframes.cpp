@@ -45,6 +45,32 @@ bool Tracker::Impl::estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_
   return true;
 }
 
+bool Tracker::Impl::priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C) {
+  if (!initialized_ || !last_tracked_ || config_.static_prior_min_keyframes <= 0) return false;
+  ScopedStageTimer timer(timings_, "motion_prior");
+  std::vector<std::uint64_t> ids(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) ids[i] = tracks_[i].landmark_id;
+  std::vector<Eigen::Vector3d> p_W;
+  std::vector<int> seen;
+  map_.landmarkPositions(ids, p_W);
+  map_.keyframeCounts(ids, seen);
+  std::vector<PoseCorrespondence> corr;
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    if (seen[i] < config_.static_prior_min_keyframes) continue;
+    PoseCorrespondence c;
+    c.p_W = p_W[i];
+    c.px = Eigen::Vector2d(tracks_[i].px.x, tracks_[i].px.y);
+    c.depth_m = sampleDepth(frame.depth_m, tracks_[i].px.x, tracks_[i].px.y, config_.depth_min_m,
+                            config_.depth_max_m);
+    corr.push_back(c);
+  }
+  if (static_cast<int>(corr.size()) < 2 * config_.min_inliers) return false;
+  const PoseEstimate est = optimizer_.estimate(corr, T_W_C, nullptr);
+  if (!est.ok) return false;
+  T_W_C = est.T_W_C;
+  return true;
+}
+
 OrbFeatures Tracker::Impl::extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask) {
   ScopedStageTimer timer(timings_, "orb");
   cv::Mat allowed;

@@ -82,6 +82,11 @@ struct DynamicConfig {
   int min_object_points = 4;        ///< tracked points needed inside an object to decide
   int min_dynamic_points = 3;       ///< dynamic points needed inside an object to call it moving
   double evidence_smoothing = 0.6;  ///< weight of the past in the per-object motion evidence
+  /// A high-dynamic object (person) is masked until this many observed frames showed it still
+  /// against a background-only camera motion (0 = kept unless it moves in this frame).
+  int static_confirm_frames = 5;
+  /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
+  int track_max_missed_frames = 8;
   double depth_band_m = 0.4;        ///< object pixels: within this of the object's depth mode
   int mask_dilation_px = 3;         ///< final dilation of each region (mapping dilates again)
   /// A moving object's pixels nearer (by more than 4 px) to a static tracked point inside it than

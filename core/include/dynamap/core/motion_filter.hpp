@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "dynamap/core/frame.hpp"
@@ -22,6 +23,11 @@ struct MotionFilterInput {
   const cv::Mat* prev_gray = nullptr;
   const cv::Mat* cur_gray = nullptr;
   const FeatureMatches* matches = nullptr;
+  /// The camera motion since the previous frame as the tracker's map sees it (a pose estimated
+  /// against landmarks that several keyframes observed, before any motion decision), so that
+  /// the geometric check does not have to take the frame-to-frame majority for the camera.
+  bool has_prior = false;
+  Eigen::Isometry3d T_prev_cur = Eigen::Isometry3d::Identity();
 };
 
 /// Result of the dynamic-point stage.

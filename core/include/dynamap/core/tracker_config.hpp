@@ -28,6 +28,11 @@ struct TrackerConfig {
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
 
+  /// With a motion filter: the camera motion handed to it is first estimated against the
+  /// tracked landmarks that at least this many keyframes observed (those proven static over
+  /// time), when there are enough of them (0 = no prior: the filter fits the motion itself).
+  int static_prior_min_keyframes = 2;
+
   // --- depth ---
   double depth_min_m = 0.1;  ///< depth readings outside [min, max] are ignored
   double depth_max_m = 6.0;
@@ -42,6 +47,11 @@ struct TrackerConfig {
   int refine_iterations = 10;        ///< Ceres iterations of the motion-only refinement
   double robust_loss_sigma = 2.8;    ///< Huber threshold on whitened residuals (sigma units)
   bool use_depth_residual = true;    ///< add a depth residual to the reprojection residual
+  /// Constant-velocity prior of the motion-only refinement: std-dev of the camera centre (m)
+  /// and rotation (deg) around the prediction (0 = off). Weak against hundreds of matches;
+  /// it keeps the pose when walkers hide most of the scene for a few frames.
+  double motion_prior_sigma_m = 0.01;
+  double motion_prior_sigma_deg = 1.0;
 
   // --- keyframe policy: a keyframe when any of these holds ---
   double kf_min_tracked_ratio = 0.6;   ///< tracked / landmarks seen by the reference keyframe

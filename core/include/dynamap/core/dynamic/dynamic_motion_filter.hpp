@@ -58,13 +58,15 @@ class DynamicMotionFilter : public MotionFilter {
  private:
   class Worker;
   void record(const std::string& stage, double ms);
-  std::vector<Detection> currentDetections(const RgbdFrame* frame);
+  std::vector<Detection> currentDetections(const RgbdFrame* frame, const FeatureMatches& m);
   bool lockstep() const;  ///< detector_async && detector_lockstep
   /// Moves the worker's newest finished detections (with `wait`, of the frame in flight) into
   /// latest_, if there are any.
   void takeDetections(bool wait);
+  /// *background_fit: the camera motion was fitted on enough matches outside people and masks.
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
-                               const std::vector<Detection>& dets);
+                               const std::vector<Detection>& dets, const RigidMotion* prior,
+                               bool* background_fit);
 
   DynamicConfig config_;
   cv::Vec4d K_;  ///< fx, fy, cx, cy

@@ -31,6 +31,8 @@ struct EpipolarResult {
   std::vector<float> residual_px;        ///< per match (0 when kNone)
   std::vector<std::uint8_t> is_dynamic;  ///< per match: residual > threshold
   cv::Mat F;                             ///< 3x3 CV_64F when model == kFundamental
+  cv::Mat H;                             ///< 3x3 CV_64F when model == kHomography
+  bool from_prior = false;  ///< kRigid: the given prior motion was taken (not RANSAC's)
 };
 
 /// Symmetric epipolar distance of p1 <-> p2 to F (x2^T F x1 = 0): the mean of the distances of
@@ -40,10 +42,13 @@ double symmetricEpipolarDistance(const cv::Matx33d& F, const cv::Point2f& p1,
 
 /// Geometric motion check on frame-to-frame matches: RANSAC (USAC) fundamental matrix,
 /// least-squares 8-point refit on the inliers, symmetric epipolar distance per match.
-/// Degenerate inputs flag nothing.
+/// Degenerate inputs flag nothing. With `fit_subset` (one flag per match, 1 = may vote) the
+/// models are fitted on the flagged matches only (too few: degenerate) and every match is
+/// checked against them.
 EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
                              const std::vector<cv::Point2f>& cur_px,
-                             const EpipolarOptions& options);
+                             const EpipolarOptions& options,
+                             const std::vector<std::uint8_t>& fit_subset = {});
 
 /// Frame-to-frame camera motion as found by checkRigidMotion(): a current-frame point X maps
 /// to the previous frame as R(rvec) X + tvec.
@@ -66,10 +71,12 @@ struct RigidMotion {
 /// ambiguous with translation (which lets a large mover's motion fit the static layer to ~1 px).
 /// Falls back to checkEpipolar() when too few matches have depth.
 /// `K` = (fx, fy, cx, cy); `fit_weight` per match (empty = all 1); `estimated` (may be null)
-/// gets the motion.
+/// gets the motion. `prior` (may be null): a motion known from elsewhere (the tracker's map);
+/// used instead of RANSAC when at least a fifth of the fit matches agree with it.
 EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
                                 const std::vector<cv::Point2f>& cur_px, const cv::Mat& depth_m,
                                 const cv::Vec4d& K, const std::vector<float>& fit_weight,
-                                const EpipolarOptions& options, RigidMotion* estimated = nullptr);
+                                const EpipolarOptions& options, RigidMotion* estimated = nullptr,
+                                const RigidMotion* prior = nullptr);
 
 }  // namespace dynamap

@@ -7,6 +7,7 @@
 
 #include "dynamap/core/dynamic/class_table.hpp"
 #include "dynamap/core/dynamic/nms.hpp"
+#include "dynamap/core/dynamic/object_tracks.hpp"
 #include "dynamap/core/dynamic_config.hpp"
 
 namespace dynamap {
@@ -25,7 +26,21 @@ struct ObjectDecision {
   int dynamic_points = 0;   ///< of which dynamic
   bool moving_now = false;  ///< evidence in this frame
   bool moving = false;      ///< after hysteresis (what is masked)
+  bool carried = false;     ///< not detected in this frame: its track carried by the flow
+  int quiet_frames = 0;     ///< observed frames with static evidence since it last moved
   double depth_m = 0.0;     ///< depth mode of the object (0 = no depth)
+};
+
+/// What, besides the point flags, fuse() may rely on in this frame.
+struct FusionEvidence {
+  /// The point flags carry information (the geometric check was not degenerate).
+  bool flags_valid = true;
+  /// The camera motion the flags were measured against was fitted without the detected
+  /// objects (enough background): only then do an object's quiet points say it stands still.
+  bool background_fit = true;
+  /// Previous-frame pixel of each point (empty: no flow). Detections (computed on the previous
+  /// frame) and undetected tracks are moved by the median flow of the points inside them.
+  std::vector<cv::Point2f> prev_points;
 };
 
 struct FusionResult {
@@ -41,34 +56,46 @@ struct FusionResult {
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
                      double* depth_mode_m);
 
-/// Fuses dynamic points and detections into a motion mask, with per-object temporal hysteresis
-/// (objects are associated frame to frame by box IoU). fuse() with `evidence_valid` = false (the
-/// point flags carry no information: degenerate geometric check): objects keep their state and
-/// no clusters are grown. Not thread-safe (one caller).
+/// Fuses dynamic points and detections into a motion mask, with per-object temporal state
+/// (objects are associated frame to frame by box IoU, boxes moved with the flow).
+/// Keeping an object of a high-dynamic class (a person) takes evidence gathered over time: it
+/// is masked until static_confirm_frames observed frames, measured against a background-only
+/// camera motion, showed it still; one frame of clear motion masks it again. A low-dynamic
+/// object (a chair) is kept until its smoothed evidence says it moves. A moving object the
+/// detector misses is still masked for track_max_missed_frames frames (its box carried by the
+/// flow). With evidence.flags_valid = false (degenerate geometric check) objects keep their
+/// state and no clusters are grown. Not thread-safe (one caller).
 class RegionFusion {
  public:
   RegionFusion(const DynamicConfig& config, const ClassTable& classes);
 
   FusionResult fuse(FusionMode mode, const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
                     const std::vector<std::uint8_t>& point_is_dynamic,
-                    const std::vector<Detection>& detections, bool evidence_valid = true);
+                    const std::vector<Detection>& detections,
+                    const FusionEvidence& evidence = FusionEvidence());
 
  private:
-  struct Track {
-    cv::Rect2f box;
-    int class_id = -1;
-    double score = 0.0;  ///< smoothed motion evidence
-    bool moving = false;
-  };
-  void decideObject(ObjectDecision& d, std::vector<Track>& next);
+  /// Moves every track's box by the median flow of the points inside it.
+  void propagateTracks(const std::vector<cv::Point2f>& points, const FusionEvidence& evidence);
+  /// Decides `d` given its track in the last frame (null: new object); returns its new track.
+  ObjectTrack decideObject(ObjectDecision& d, const ObjectTrack* prev,
+                           const FusionEvidence& evidence) const;
+  /// The object's own pixels in `box` (depth cut, or the box without depth); counts the
+  /// points on them into d.
+  cv::Mat objectRegion(const cv::Mat& depth_m, const cv::Rect& box, ObjectDecision& d,
+                       const std::vector<cv::Point2f>& points,
+                       const std::vector<std::uint8_t>& dyn) const;
+  /// Masks (moving, static points carved out) or keeps the decided object.
+  void applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
+                   const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
+                   FusionResult& result) const;
   int growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
                    const std::vector<std::uint8_t>& dyn, const cv::Mat& claimed,
                    cv::Mat& mask) const;
 
   DynamicConfig config_;
   ClassTable classes_;
-  std::vector<Track> tracks_;
-  bool evidence_valid_ = true;
+  std::vector<ObjectTrack> tracks_;
 };
 
 }  // namespace dynamap

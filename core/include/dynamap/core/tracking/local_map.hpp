@@ -17,6 +17,7 @@ struct Landmark {
   Eigen::Vector3d p_W;
   cv::Mat descriptor;  ///< 1 x 32 CV_8U
   bool bad = false;    ///< seen on a moving object: never used again
+  int keyframes = 0;   ///< keyframes that observed it
 };
 
 struct KeyframeObservation {
@@ -63,6 +64,8 @@ class LocalMap {
   /// out[i] = position of ids[i].
   void landmarkPositions(const std::vector<std::uint64_t>& ids,
                          std::vector<Eigen::Vector3d>& out) const;
+  /// out[i] = number of keyframes that observed ids[i].
+  void keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector<int>& out) const;
 
   /// The newest `window` keyframes; the oldest `fixed` of them and up to `window` older ones
   /// that see the same landmarks are held fixed.

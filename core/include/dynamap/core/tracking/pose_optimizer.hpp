@@ -45,8 +45,12 @@ class PoseOptimizer {
 
   /// Motion-only refinement over the flagged correspondences; re-classifies inliers with a
   /// chi-square test. Returns the inlier count.
+  /// `predicted` (may be null): the constant-velocity prediction; with
+  /// motion_prior_sigma_m > 0 the pose is held near it with that standard deviation of the
+  /// camera centre (and motion_prior_sigma_deg of the rotation), which only matters when few
+  /// matches constrain the pose (a hand-held camera does not jump while walkers hide the scene).
   int refine(const std::vector<PoseCorrespondence>& corr, Eigen::Isometry3d& T_W_C,
-             std::vector<std::uint8_t>& inlier) const;
+             std::vector<std::uint8_t>& inlier, const Eigen::Isometry3d* predicted = nullptr) const;
 
  private:
   PinholeCamera camera_;

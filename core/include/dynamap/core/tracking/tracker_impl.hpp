@@ -54,10 +54,14 @@ class Tracker::Impl {
   void trackProbes(const LkPyramid& cur, FeatureMatches& matches);
   void refillProbes(const cv::Mat& gray);
   MotionFilterOutput runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,
-                                     const FeatureMatches& matches);
+                                     const FeatureMatches& matches,
+                                     const Eigen::Isometry3d* T_W_C_prior);
   int dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out);
   void cullMovedLandmarks(const Eigen::Isometry3d& T_W_C);
   bool estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The pose against the tracked landmarks proven static over time (seen by at least
+  /// static_prior_min_keyframes keyframes), tracks left untouched; false if too few.
+  bool priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C);
   bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
                   Eigen::Isometry3d& T_W_C, int& inliers);
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const;
