@@ -55,7 +55,10 @@ TEST(RegionFusion, MasksTheMovingPersonAndKeepsTheStandingOne) {
   Scene s;
   DynamicConfig c;
   RegionFusion fusion(c, ClassTable(c));
-  const FusionResult r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, s.detections);
+  // A person is kept only after static_confirm_frames quiet frames (fusion_time_test.cpp).
+  FusionResult r;
+  for (int i = 0; i <= c.static_confirm_frames; ++i)
+    r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, s.detections);
   ASSERT_EQ(r.objects.size(), 2u);
   EXPECT_FALSE(r.objects[0].moving);
   EXPECT_TRUE(r.objects[1].moving);
@@ -78,9 +81,9 @@ TEST(RegionFusion, HysteresisNeedsEvidenceToSwitchAndHoldsThroughAQuietFrame) {
   std::vector<std::uint8_t> quiet(s.dynamic.size(), 0);
   EXPECT_TRUE(
       fusion.fuse(FusionMode::kBoth, s.depth, s.points, quiet, s.detections).objects[1].moving);
-  // Several static frames: B is released.
+  // Enough static frames (static_confirm_frames): B is released.
   bool moving = true;
-  for (int i = 0; i < 4; ++i)
+  for (int i = 0; i < c.static_confirm_frames; ++i)
     moving =
         fusion.fuse(FusionMode::kBoth, s.depth, s.points, quiet, s.detections).objects[1].moving;
   EXPECT_FALSE(moving);

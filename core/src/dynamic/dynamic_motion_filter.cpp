@@ -265,8 +265,7 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
     *background_fit = r.model != EpipolarModel::kNone;
     return r;
   }
-  EpipolarResult r =
-      checkRigidMotion(m.prev_px, m.cur_px, depth, K_, weight, eo, &motion_, prior);
+  EpipolarResult r = checkRigidMotion(m.prev_px, m.cur_px, depth, K_, weight, eo, &motion_, prior);
   *background_fit =
       r.model == EpipolarModel::kRigid && (r.from_prior || background >= config_.min_matches);
   return r;
@@ -307,6 +306,14 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   }
   evidence.flags_valid = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
   evidence.prev_points = m.prev_px;
+  if (input.proven_static != nullptr) evidence.proven_static = *input.proven_static;
+  if (input.has_prior) {
+    evidence.has_pose = true;
+    const Eigen::Matrix4d T = input.T_W_C.matrix();
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) evidence.T_W_C(r, c) = T(r, c);
+    evidence.K = K_;
+  }
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
   MotionFilterOutput out;
   out.match_is_dynamic.resize(m.cur_px.size(), 0);

@@ -67,10 +67,10 @@ EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
     r.model = fit.model;
     r.F = fit.F;
     for (std::size_t i = 0; i < n; ++i) {
-      r.residual_px[i] = static_cast<float>(
-          fit.model == EpipolarModel::kHomography
-              ? transferError(cv::Matx33d(fit.H), all1[i], all2[i])
-              : symmetricEpipolarDistance(cv::Matx33d(fit.F), all1[i], all2[i]));
+      r.residual_px[i] =
+          static_cast<float>(fit.model == EpipolarModel::kHomography
+                                 ? transferError(cv::Matx33d(fit.H), all1[i], all2[i])
+                                 : symmetricEpipolarDistance(cv::Matx33d(fit.F), all1[i], all2[i]));
       const double thr = (fit.model == EpipolarModel::kHomography ? 2.0 : 1.0) * o.threshold_px;
       r.is_dynamic[i] = r.residual_px[i] > thr;
     }

@@ -1,6 +1,7 @@
 #include "dynamap/core/dynamic/region_fusion.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include <opencv2/imgproc.hpp>
@@ -10,20 +11,22 @@ namespace dynamap {
 namespace {
 
 constexpr double kBinM = 0.1;
-constexpr int kStaticShareInverse = 10;  ///< < 1/10 of an object's points dynamic: static now
-constexpr int kStaticMinPoints = 5;      ///< ... with at least this many points
-constexpr int kBins = 100;               // 0..10 m
-constexpr float kMatchIou = 0.3f;        ///< a detection continues a track above this IoU
+constexpr int kStaticMinPoints = 5;  ///< points needed on an object to call it static now
+constexpr int kBins = 100;           // 0..10 m
+constexpr float kMatchIou = 0.3f;    ///< a detection continues a track above this IoU
 
-/// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few.
-double depthMode(const cv::Mat& roi) {
+/// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few. With `near_m` > 0
+/// only depths within kContinuityM of it compete (the object was there a frame ago).
+constexpr double kContinuityM = 0.5;
+double depthMode(const cv::Mat& roi, double near_m) {
   std::vector<int> hist(kBins + 2, 0);
   int total = 0;
   for (int y = 0; y < roi.rows; y += 2) {
     const float* row = roi.ptr<float>(y);
     for (int x = 0; x < roi.cols; x += 2) {
       const int b = static_cast<int>(row[x] / kBinM);
-      if (row[x] > 0.f && b < kBins) {
+      const bool near = near_m <= 0.0 || std::abs(row[x] - near_m) < kContinuityM;
+      if (row[x] > 0.f && b < kBins && near) {
         ++hist[b + 1];
         ++total;
       }
@@ -85,10 +88,12 @@ cv::Rect clampRect(const cv::Rect2f& r, const cv::Size& size) {
 }
 
 /// Removes from `region` (inside `box`) the pixels that are nearer, by more than kCarveMarginPx,
-/// to a static tracked point inside the region than to a dynamic one, and within `radius` of it.
+/// to a proven-static tracked point inside the region than to a dynamic one, and within `radius`
+/// of it. Points neither dynamic nor proven static take no part.
 constexpr float kCarveMarginPx = 4.f;
 void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Point2f>& points,
-                 const std::vector<std::uint8_t>& dyn, double radius) {
+                 const std::vector<std::uint8_t>& dyn, const std::vector<std::uint8_t>& proven,
+                 double radius) {
   if (radius <= 0.0 || box.area() <= 0) return;
   cv::Mat roi = region(box);
   cv::Mat dyn_free(box.size(), CV_8UC1, cv::Scalar(255));
@@ -98,6 +103,7 @@ void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Poi
     const cv::Point p(cvRound(points[i].x) - box.x, cvRound(points[i].y) - box.y);
     if (p.x < 0 || p.y < 0 || p.x >= box.width || p.y >= box.height) continue;
     if (roi.at<uchar>(p) == 0) continue;
+    if (!dyn[i] && (i >= proven.size() || proven[i] == 0)) continue;
     (dyn[i] ? dyn_free : static_free).at<uchar>(p) = 0;
     ++(dyn[i] ? n_dyn : n_static);
   }
@@ -113,13 +119,14 @@ void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Poi
 }  // namespace
 
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
-                     double* depth_mode_m) {
+                     double* depth_mode_m, double prior_depth_m) {
   if (depth_mode_m != nullptr) *depth_mode_m = 0.0;
   const cv::Rect box = box_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
   if (box.width < 4 || box.height < 4) return {};
   const cv::Rect inner(box.x + box.width / 4, box.y + box.height * 15 / 100,
                        std::max(1, box.width / 2), std::max(1, box.height * 70 / 100));
-  const double mode = depthMode(depth_m(inner));
+  double mode = prior_depth_m > 0.0 ? depthMode(depth_m(inner), prior_depth_m) : 0.0;
+  if (mode <= 0.0) mode = depthMode(depth_m(inner), 0.0);
   if (mode <= 0.0) return {};
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
   cv::Mat sel = (depth_m(box) > mode - band_m) & (depth_m(box) < mode + band_m);
@@ -149,9 +156,10 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   d.moving_now = observed && d.dynamic_points >= config_.min_dynamic_points &&
                  evidence >= config_.moving_ratio;
   const bool quiet = observed && d.points >= kStaticMinPoints &&
-                     d.dynamic_points * kStaticShareInverse < d.points;
+                     d.dynamic_points <= config_.static_max_dynamic_share * d.points;
   ObjectTrack t;
   t.box = d.detection.box;
+  t.depth_m = d.depth_m > 0.0 || prev == nullptr ? d.depth_m : prev->depth_m;
   t.class_id = d.detection.class_id;
   const double a = config_.evidence_smoothing;
   t.score = evidence;
@@ -166,11 +174,19 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
     t.score = a * t.score + (1.0 - a) * evidence;
     t.moving = was_moving && t.score >= 0.5 * config_.moving_ratio;
   }
+  // Keeping a person takes evidence gathered over time, measured against a camera motion
+  // fitted without it; one frame of clear motion removes it again.
+  int before = prev != nullptr ? prev->quiet_frames : 0;
+  if (prev != nullptr && prev->has_anchor) t.has_anchor = true, t.anchor_W = prev->anchor_W;
+  if (d.has_position && config_.static_max_drift_m > 0.0) {
+    // Frame-to-frame checks cannot see a slow walker (a pixel a frame): its world position can.
+    if (!t.has_anchor || cv::norm(d.p_W - t.anchor_W) > config_.static_max_drift_m) {
+      t.has_anchor = true, t.anchor_W = d.p_W, before = 0;
+    }
+  }
+  t.quiet_frames = d.moving_now ? 0 : before + (quiet && ev.background_fit ? 1 : 0);
+  if (d.moving_now) t.has_anchor = false;
   if (classes_.isHighDynamic(d.detection.class_id)) {
-    // Keeping a person takes evidence gathered over time, measured against a camera motion
-    // fitted without it; one frame of clear motion removes it again.
-    const int before = prev != nullptr ? prev->quiet_frames : 0;
-    t.quiet_frames = d.moving_now ? 0 : before + (quiet && ev.background_fit ? 1 : 0);
     t.moving = t.moving || t.quiet_frames < config_.static_confirm_frames;
   }
   d.moving = t.moving;
@@ -187,13 +203,26 @@ void RegionFusion::propagateTracks(const std::vector<cv::Point2f>& points,
   }
 }
 
-cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box,
-                                   ObjectDecision& d, const std::vector<cv::Point2f>& points,
-                                   const std::vector<std::uint8_t>& dyn) const {
-  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m);
+cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, ObjectDecision& d,
+                                   const std::vector<cv::Point2f>& points,
+                                   const std::vector<std::uint8_t>& dyn,
+                                   const ObjectTrack* prev) const {
+  const double prior = prev != nullptr ? prev->depth_m : 0.0;
+  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);
+  }
+  if (evidence_->has_pose && d.depth_m > 0.0) {
+    const cv::Moments m = cv::moments(region(box), true);
+    if (m.m00 > 0.0) {
+      const double u = box.x + m.m10 / m.m00, v = box.y + m.m01 / m.m00, z = d.depth_m;
+      const cv::Vec4d& K = evidence_->K;
+      const cv::Vec4d p_C((u - K[2]) / K[0] * z, (v - K[3]) / K[1] * z, z, 1.0);
+      const cv::Vec4d p_W = evidence_->T_W_C * p_C;
+      d.p_W = cv::Vec3d(p_W[0], p_W[1], p_W[2]);
+      d.has_position = true;
+    }
   }
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!inside(region, points[i])) continue;
@@ -207,9 +236,10 @@ void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& regi
                                const cv::Rect& box, const std::vector<cv::Point2f>& points,
                                const std::vector<std::uint8_t>& dyn, FusionResult& result) const {
   if (d.moving && mode == FusionMode::kBoth) {
-    carveStatic(region, box, points, dyn, config_.static_carve_radius_px);
+    carveStatic(region, box, points, dyn, proven_, config_.static_carve_radius_px);
   }
   (d.moving ? result.mask : result.static_objects) |= region;
+  if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) confirmed_ |= region;
   result.objects.push_back(d);
 }
 
@@ -219,6 +249,9 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const std::vector<Detection>& detections,
                                 const FusionEvidence& evidence) {
   FusionResult result;
+  proven_ = evidence.proven_static;
+  evidence_ = &evidence;
+  confirmed_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.static_objects = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
@@ -235,11 +268,11 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
       if (mode == FusionMode::kDetector && !classes_.isHighDynamic(d.detection.class_id)) continue;
       const cv::Rect box = clampRect(d.detection.box, depth_m.size());
       if (box.area() <= 0) continue;
-      cv::Mat region = objectRegion(depth_m, box, d, points, dyn);
+      const ObjectTrack* prev = track_of[k] >= 0 ? &tracks_[track_of[k]] : nullptr;
+      cv::Mat region = objectRegion(depth_m, box, d, points, dyn, prev);
       if (mode == FusionMode::kDetector) {
         d.moving_now = d.moving = true;
       } else {
-        const ObjectTrack* prev = track_of[k] >= 0 ? &tracks_[track_of[k]] : nullptr;
         if (prev != nullptr) matched[track_of[k]] = true;
         next.push_back(decideObject(d, prev, evidence));
       }
@@ -259,7 +292,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
       d.detection = Detection{track.box, track.class_id, 0.f};
       d.weight = classes_.weight(track.class_id);
       d.carried = true;
-      cv::Mat region = objectRegion(depth_m, box, d, points, dyn);
+      cv::Mat region = objectRegion(depth_m, box, d, points, dyn, &track);
       next.push_back(decideObject(d, &track, evidence));
       next.back().missed = track.missed + 1;
       claimed |= region;
@@ -267,6 +300,9 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     }
   }
   tracks_ = std::move(next);
+  // What has proven static over time is not another object's: a walker's box that covers the
+  // teddy (or a standing person) must not take its depth cut.
+  if (cv::countNonZero(confirmed_) > 0) result.mask.setTo(0, confirmed_);
   if (mode != FusionMode::kDetector && evidence.flags_valid) {
     result.clusters = growClusters(depth_m, points, dyn, claimed, result.mask);
   }
@@ -313,7 +349,7 @@ int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Poi
     }
     cv::Mat filled = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     filled(roi).setTo(255, flood(cv::Rect(1, 1, roi.width, roi.height)) == 255);
-    carveStatic(filled, roi, points, dyn, config_.static_carve_radius_px);
+    carveStatic(filled, roi, points, dyn, proven_, config_.static_carve_radius_px);
     filled = filled(roi);
     if (cv::countNonZero(filled) == 0) {  // no depth: the hull of the points
       std::vector<cv::Point> hull;

@@ -137,9 +137,9 @@ int PoseOptimizer::refine(const std::vector<PoseCorrespondence>& corr, Eigen::Is
     }
     if (use_prior && used > 0) {
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 6>(new MotionPriorResidual(
-              pred, 1.0 / (config_.motion_prior_sigma_deg * M_PI / 180.0),
-              1.0 / config_.motion_prior_sigma_m)),
+          new ceres::AutoDiffCostFunction<MotionPriorResidual, 6, 6>(
+              new MotionPriorResidual(pred, 1.0 / (config_.motion_prior_sigma_deg * M_PI / 180.0),
+                                      1.0 / config_.motion_prior_sigma_m)),
           nullptr, pose);
     }
     if (used < 4) break;

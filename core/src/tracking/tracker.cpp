@@ -239,11 +239,17 @@ MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const 
   if (T_W_C_prior != nullptr) {
     input.has_prior = true;
     input.T_prev_cur = T_W_last_.inverse() * *T_W_C_prior;
+    input.T_W_C = *T_W_C_prior;
   }
   input.frame = &frame;
   input.prev_gray = prev_gray_.empty() ? &gray : &prev_gray_;
   input.cur_gray = &gray;
   input.matches = &matches;
+  std::vector<std::uint8_t> proven(matches.cur_px.size(), 0);  // tracks first, probes after
+  for (std::size_t i = 0; i < proven_static_.size() && i < proven.size(); ++i) {
+    proven[i] = proven_static_[i];
+  }
+  input.proven_static = &proven;
   return filter_->filter(input);
 }
 

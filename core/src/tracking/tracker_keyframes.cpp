@@ -46,6 +46,7 @@ bool Tracker::Impl::estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_
 }
 
 bool Tracker::Impl::priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C) {
+  proven_static_.clear();
   if (!initialized_ || !last_tracked_ || config_.static_prior_min_keyframes <= 0) return false;
   ScopedStageTimer timer(timings_, "motion_prior");
   std::vector<std::uint64_t> ids(tracks_.size());
@@ -55,8 +56,11 @@ bool Tracker::Impl::priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C) 
   map_.landmarkPositions(ids, p_W);
   map_.keyframeCounts(ids, seen);
   std::vector<PoseCorrespondence> corr;
+  std::vector<std::size_t> track_of;
+  proven_static_.assign(tracks_.size(), 0);
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     if (seen[i] < config_.static_prior_min_keyframes) continue;
+    track_of.push_back(i);
     PoseCorrespondence c;
     c.p_W = p_W[i];
     c.px = Eigen::Vector2d(tracks_[i].px.x, tracks_[i].px.y);
@@ -67,6 +71,9 @@ bool Tracker::Impl::priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C) 
   if (static_cast<int>(corr.size()) < 2 * config_.min_inliers) return false;
   const PoseEstimate est = optimizer_.estimate(corr, T_W_C, nullptr);
   if (!est.ok) return false;
+  for (std::size_t k = 0; k < track_of.size() && k < est.inlier.size(); ++k) {
+    proven_static_[track_of[k]] = est.inlier[k];
+  }
   T_W_C = est.T_W_C;
   return true;
 }

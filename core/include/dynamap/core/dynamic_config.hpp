@@ -85,10 +85,16 @@ struct DynamicConfig {
   /// A high-dynamic object (person) is masked until this many observed frames showed it still
   /// against a background-only camera motion (0 = kept unless it moves in this frame).
   int static_confirm_frames = 5;
+  /// An observed frame counts as static evidence when at most this share of the object's points
+  /// is dynamic (a near object's edges and occlusions flag a few points of a still one).
+  double static_max_dynamic_share = 0.25;
+  /// ... and while its world position (centroid of its pixels, camera pose from landmarks proven
+  /// static) stays within this of where the quiet run began (m; 0 = not checked).
+  double static_max_drift_m = 0.25;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
-  double depth_band_m = 0.4;        ///< object pixels: within this of the object's depth mode
-  int mask_dilation_px = 3;         ///< final dilation of each region (mapping dilates again)
+  double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode
+  int mask_dilation_px = 3;   ///< final dilation of each region (mapping dilates again)
   /// A moving object's pixels nearer (by more than 4 px) to a static tracked point inside it than
   /// to any dynamic one, and within this radius of it, are not masked: a standing person next to
   /// a walker at the same depth falls into the walker's depth cut. 0 = off.

@@ -28,6 +28,10 @@ struct MotionFilterInput {
   /// the geometric check does not have to take the frame-to-frame majority for the camera.
   bool has_prior = false;
   Eigen::Isometry3d T_prev_cur = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  ///< the prior pose (with has_prior)
+  /// Per match (may be null): 1 = a landmark that several keyframes saw at one place and that
+  /// fits the prior motion: static over time, not just in this frame.
+  const std::vector<std::uint8_t>* proven_static = nullptr;
 };
 
 /// Result of the dynamic-point stage.

@@ -46,8 +46,7 @@ double symmetricEpipolarDistance(const cv::Matx33d& F, const cv::Point2f& p1,
 /// models are fitted on the flagged matches only (too few: degenerate) and every match is
 /// checked against them.
 EpipolarResult checkEpipolar(const std::vector<cv::Point2f>& prev_px,
-                             const std::vector<cv::Point2f>& cur_px,
-                             const EpipolarOptions& options,
+                             const std::vector<cv::Point2f>& cur_px, const EpipolarOptions& options,
                              const std::vector<std::uint8_t>& fit_subset = {});
 
 /// Frame-to-frame camera motion as found by checkRigidMotion(): a current-frame point X maps

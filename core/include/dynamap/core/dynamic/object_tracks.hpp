@@ -15,6 +15,9 @@ struct ObjectTrack {
   double score = 0.0;    ///< smoothed motion evidence (low-dynamic classes)
   int quiet_frames = 0;  ///< observed frames with clear static evidence since it last moved
   int missed = 0;        ///< frames since the detector last reported it
+  double depth_m = 0.0;  ///< depth mode of its pixels when last seen (0 = unknown)
+  bool has_anchor = false;
+  cv::Vec3d anchor_W;  ///< world position where its current run of quiet frames began
   bool moving = false;
 };
 

@@ -29,6 +29,8 @@ struct ObjectDecision {
   bool carried = false;     ///< not detected in this frame: its track carried by the flow
   int quiet_frames = 0;     ///< observed frames with static evidence since it last moved
   double depth_m = 0.0;     ///< depth mode of the object (0 = no depth)
+  bool has_position = false;
+  cv::Vec3d p_W;  ///< centroid of its pixels in the world (with FusionEvidence::has_pose)
 };
 
 /// What, besides the point flags, fuse() may rely on in this frame.
@@ -41,6 +43,15 @@ struct FusionEvidence {
   /// Previous-frame pixel of each point (empty: no flow). Detections (computed on the previous
   /// frame) and undetected tracks are moved by the median flow of the points inside them.
   std::vector<cv::Point2f> prev_points;
+  /// Per point (empty: none): static over time (a landmark several keyframes saw). Only these
+  /// carve static pixels out of a moving region: one frame's quiet flag is no proof when the
+  /// camera motion was measured among movers.
+  std::vector<std::uint8_t> proven_static;
+  /// The camera pose (camera -> world) from landmarks proven static, and the intrinsics
+  /// (fx, fy, cx, cy): an object's world position over time (has_pose false: not used).
+  bool has_pose = false;
+  cv::Matx44d T_W_C = cv::Matx44d::eye();
+  cv::Vec4d K;
 };
 
 struct FusionResult {
@@ -54,7 +65,7 @@ struct FusionResult {
 /// the box centre, largest connected component, holes closed. Empty Mat if no depth.
 /// Returns a full-image CV_8UC1 mask (255 = object) and the mode in *depth_mode_m.
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
-                     double* depth_mode_m);
+                     double* depth_mode_m, double prior_depth_m = 0.0);
 
 /// Fuses dynamic points and detections into a motion mask, with per-object temporal state
 /// (objects are associated frame to frame by box IoU, boxes moved with the flow).
@@ -83,8 +94,8 @@ class RegionFusion {
   /// The object's own pixels in `box` (depth cut, or the box without depth); counts the
   /// points on them into d.
   cv::Mat objectRegion(const cv::Mat& depth_m, const cv::Rect& box, ObjectDecision& d,
-                       const std::vector<cv::Point2f>& points,
-                       const std::vector<std::uint8_t>& dyn) const;
+                       const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
+                       const ObjectTrack* prev) const;
   /// Masks (moving, static points carved out) or keeps the decided object.
   void applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                    const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
@@ -96,6 +107,9 @@ class RegionFusion {
   DynamicConfig config_;
   ClassTable classes_;
   std::vector<ObjectTrack> tracks_;
+  std::vector<std::uint8_t> proven_;  ///< this frame's FusionEvidence::proven_static
+  cv::Mat confirmed_;                 ///< this frame's pixels of objects confirmed static over time
+  const FusionEvidence* evidence_ = nullptr;  ///< during fuse()
 };
 
 }  // namespace dynamap

@@ -85,7 +85,10 @@ class Tracker::Impl {
   cv::Mat prev_gray_;
   std::vector<FeatureTrack> tracks_;   ///< parallel to the matches of the current frame
   std::vector<FeatureTrack> dropped_;  ///< tracks the motion filter dropped this frame
-  std::vector<cv::Point2f> probes_;    ///< motion probes in the previous frame (not landmarks)
+  /// Per track this frame: a landmark seen by static_prior_min_keyframes keyframes that fits
+  /// priorPose() (set by priorPose(), read by runMotionFilter()).
+  std::vector<std::uint8_t> proven_static_;
+  std::vector<cv::Point2f> probes_;  ///< motion probes in the previous frame (not landmarks)
   bool initialized_ = false;
   bool finished_ = false;
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
