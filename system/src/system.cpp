@@ -13,7 +13,6 @@
 namespace dynamap {
 
 struct System::Impl {
-  AppConfig config;
   SystemOptions options;
   PinholeCamera camera;
   TimingRecorder own_timings;
@@ -48,7 +47,6 @@ cv::Mat maskOrZeros(const cv::Mat& mask, const cv::Size& size) {
 
 System::System(const AppConfig& config, SystemOptions options) : impl_(std::make_unique<Impl>()) {
   auto& s = *impl_;
-  s.config = config;
   s.options = std::move(options);
   if (s.options.timings != nullptr) s.timings = s.options.timings;
   s.camera = config.resolvedCamera();
@@ -198,8 +196,6 @@ void System::exportMap(const std::string& dir) {
   impl_->mapper->exportMap(dir);
 }
 
-const AppConfig& System::config() const { return impl_->config; }
-const PinholeCamera& System::camera() const { return impl_->camera; }
 const TimingRecorder& System::timings() const { return *impl_->timings; }
 const MotionFilter* System::motionFilter() const { return impl_->motion_filter.get(); }
 

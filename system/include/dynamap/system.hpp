@@ -109,8 +109,6 @@ class System {
   /// finish(), then writes the backend's map files into `dir` (created if needed).
   void exportMap(const std::string& dir);
 
-  const AppConfig& config() const;
-  const PinholeCamera& camera() const;
   /// Per-stage timings of every thread so far (SystemOptions::timings when given).
   const TimingRecorder& timings() const;
   /// The motion filter in use (may be null: dynamic.mode=off or given poses).
