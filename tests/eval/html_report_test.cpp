@@ -130,6 +130,14 @@ TEST(JsonIo, ReadsFilesAndNamesThemInErrors) {
     EXPECT_NE(std::string(e.what()).find("bad.json: invalid JSON at byte"), std::string::npos);
   }
   EXPECT_THROW((void)readJsonFile((dir / "none.json").string()), std::runtime_error);
+  // Found by json_fuzzer: nlohmann reports a number overflow as out_of_range, not parse_error.
+  writeText(dir / "overflow.json", "[1e338, -0, 0.5]");
+  try {
+    (void)readJsonFile((dir / "overflow.json").string());
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow.json: invalid JSON"), std::string::npos);
+  }
 }
 
 TEST(JsonIo, DumpNeverThrowsAndWritesNullForNonFiniteNumbers) {

@@ -16,6 +16,8 @@ Json readJsonFile(const std::string& path) {
   } catch (const Json::parse_error& e) {
     throw std::runtime_error(path + ": invalid JSON at byte " + std::to_string(e.byte) + " (" +
                              e.what() + ")");
+  } catch (const Json::exception& e) {  // e.g. out_of_range: a number like 1e400 overflows
+    throw std::runtime_error(path + ": invalid JSON (" + e.what() + ")");
   }
 }
 

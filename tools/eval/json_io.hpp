@@ -11,8 +11,8 @@ namespace dynamap {
 /// their keys in insertion / file order.
 using Json = nlohmann::ordered_json;
 
-/// Reads and parses a JSON file. Throws std::runtime_error "<path>: invalid JSON at byte N (...)"
-/// or "<path>: cannot open".
+/// Reads and parses a JSON file. Throws std::runtime_error "<path>: invalid JSON at byte N (...)",
+/// "<path>: invalid JSON (...)" (a number out of range) or "<path>: cannot open"; nothing else.
 Json readJsonFile(const std::string& path);
 
 /// Text of `json`: one line (indent < 0) or pretty with `indent` spaces. NaN and infinities
