@@ -7,6 +7,7 @@ find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d vide
 find_package(Ceres REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json 3 CONFIG REQUIRED)
 
 if(DYNAMAP_WITH_OPENVDB)
   list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)

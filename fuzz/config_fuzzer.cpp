@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "app_config.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "fuzz_util.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_test_util.hpp"
-#include "json_reader.hpp"
+#include "json_io.hpp"
 #include "test_paths.hpp"
 
 namespace dynamap {
@@ -47,10 +47,10 @@ test::CommandResult runFast(const fs::path& seq, const fs::path& out) {
 }
 
 /// run.json's "counts" member `key` (-1 when absent).
-double count(const JsonValue& run, const std::string& key) {
-  const JsonValue* counts = run.find("counts");
+double count(const Json& run, const std::string& key) {
+  const Json* counts = findMember(run, "counts");
   if (counts == nullptr) return -1;
-  return counts->number(key).value_or(-1);
+  return numberMember(*counts, key).value_or(-1);
 }
 
 /// Runs the detector mode with the given model overrides on 3 frames: the run must stop before
@@ -72,9 +72,9 @@ void expectModelErrorBeforeFirstFrame(const std::string& name,
   EXPECT_NE(r.err.find(expect_in_error), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out / "trajectory.txt"));
   if (fs::exists(out / "run.json")) {
-    const JsonValue run = readJsonFile((out / "run.json").string());
+    const Json run = readJsonFile((out / "run.json").string());
     EXPECT_EQ(count(run, "frames_read"), 0.0);
-    EXPECT_EQ(run.string("status").value_or(""), "failed");
+    EXPECT_EQ(stringMember(run, "status").value_or(""), "failed");
   }
 }
 
@@ -149,8 +149,8 @@ TEST(FaultInjection, AllZeroDepthFramesAreTrackedAndCounted) {
   const fs::path out = test::freshTempDir("fault_zerodepth_out");
   const auto r = runFast(seq, out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const JsonValue run = readJsonFile((out / "run.json").string());
-  EXPECT_EQ(run.string("status").value_or(""), "complete");
+  const Json run = readJsonFile((out / "run.json").string());
+  EXPECT_EQ(stringMember(run, "status").value_or(""), "complete");
   EXPECT_EQ(count(run, "frames_read"), static_cast<double>(kFrames));
   EXPECT_EQ(count(run, "bad_frames"), 0.0);  // no depth is a valid frame, not a bad one
   EXPECT_LE(count(run, "tracked") + count(run, "relocalized") + count(run, "lost"),
@@ -178,8 +178,8 @@ TEST(FaultInjection, LongTrackingLossRelocalizesOrReportsLost) {
   const fs::path out = test::freshTempDir("fault_blackout_out");
   const auto r = runFast(seq, out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const JsonValue run = readJsonFile((out / "run.json").string());
-  EXPECT_EQ(run.string("status").value_or(""), "complete");
+  const Json run = readJsonFile((out / "run.json").string());
+  EXPECT_EQ(stringMember(run, "status").value_or(""), "complete");
   EXPECT_EQ(count(run, "frames_read"), static_cast<double>(kFrames));
   EXPECT_EQ(count(run, "bad_frames"), 0.0);
   EXPECT_GE(count(run, "lost"), 1.0) << "black frames cannot be tracked";

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "app_config.hpp"
 #include "cli_test_util.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "map_metrics.hpp"
 #include "test_paths.hpp"
 #include "trajectory_io.hpp"

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "app_config.hpp"
 #include "dynamap/core/dynamic/class_table.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "test_paths.hpp"
 
 namespace dynamap {

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -9,7 +10,7 @@
 
 #include "dynamap/mapping/ply_io.hpp"
 #include "html_report.hpp"
-#include "json_reader.hpp"
+#include "json_io.hpp"
 #include "test_paths.hpp"
 #include "trajectory_io.hpp"
 
@@ -107,20 +108,45 @@ TEST(HtmlReport, BrokenJsonIsNotedWithItsFileName) {
   EXPECT_TRUE(fs::exists(dir / "report.html"));
 }
 
-TEST(JsonReader, ParsesNestedValuesAndEscapes) {
-  const JsonValue v =
-      parseJson(R"({"a": 1.5e2, "b": [true, false, null], "c": {"d": "x\"y\u00e9\n"}, "e": -3})");
-  EXPECT_DOUBLE_EQ(*v.number("a"), 150.0);
-  ASSERT_EQ(v.find("b")->items().size(), 3u);
-  EXPECT_TRUE(v.find("b")->items()[0].asBool());
-  EXPECT_EQ(v.find("b")->items()[2].type(), JsonValue::Type::kNull);
-  EXPECT_EQ(*v.find("c")->string("d"), "x\"y\xc3\xa9\n");
-  EXPECT_DOUBLE_EQ(*v.number("e"), -3.0);
-  EXPECT_FALSE(v.number("missing").has_value());
-  EXPECT_FALSE(v.number("c").has_value());
-  EXPECT_THROW(parseJson("{\"a\": }", "t"), JsonParseError);
-  EXPECT_THROW(parseJson("[1, 2", "t"), JsonParseError);
-  EXPECT_THROW(parseJson("{} x", "t"), JsonParseError);
+TEST(JsonIo, ReadsFilesAndNamesThemInErrors) {
+  const fs::path dir = test::freshTempDir("json_io");
+  writeText(dir / "a.json",
+            R"({"a": 1.5e2, "b": [true, null], "c": {"d": "x\"y\u00e9"}, "e": "s"})");
+  const Json v = readJsonFile((dir / "a.json").string());
+  EXPECT_DOUBLE_EQ(*numberMember(v, "a"), 150.0);
+  EXPECT_EQ(*stringMember(*findMember(v, "c"), "d"), "x\"y\xc3\xa9");
+  EXPECT_FALSE(numberMember(v, "e").has_value());
+  EXPECT_FALSE(stringMember(v, "a").has_value());
+  EXPECT_EQ(findMember(v, "missing"), nullptr);
+  EXPECT_EQ(findMember((*findMember(v, "b"))[0], "x"), nullptr);  // not an object
+  std::vector<std::string> keys;
+  for (const auto& member : v.items()) keys.push_back(member.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"a", "b", "c", "e"}));  // file order kept
+  writeText(dir / "bad.json", "[1, 2");
+  try {
+    (void)readJsonFile((dir / "bad.json").string());
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.json: invalid JSON at byte"), std::string::npos);
+  }
+  EXPECT_THROW((void)readJsonFile((dir / "none.json").string()), std::runtime_error);
+  // Found by json_fuzzer: nlohmann reports a number overflow as out_of_range, not parse_error.
+  writeText(dir / "overflow.json", "[1e338, -0, 0.5]");
+  try {
+    (void)readJsonFile((dir / "overflow.json").string());
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow.json: invalid JSON"), std::string::npos);
+  }
+}
+
+TEST(JsonIo, DumpNeverThrowsAndWritesNullForNonFiniteNumbers) {
+  const Json j = {{"nan", std::numeric_limits<double>::quiet_NaN()},
+                  {"inf", std::numeric_limits<double>::infinity()},
+                  {"bad_utf8", std::string("a\xff")},
+                  {"x", 0.5}};
+  EXPECT_EQ(dumpJson(j), "{\"nan\":null,\"inf\":null,\"bad_utf8\":\"a\xef\xbf\xbd\",\"x\":0.5}");
+  EXPECT_EQ(dumpJson(Json{{"a", 1}}, 2), "{\n  \"a\": 1\n}");
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
-#include "config_schema.hpp"
+#include "dynamap/system/config_schema.hpp"
 
 #include <gtest/gtest.h>
 
-#include "app_config.hpp"
+#include "dynamap/system/app_config.hpp"
 
 namespace dynamap {
 namespace {

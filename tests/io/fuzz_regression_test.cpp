@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "app_config.hpp"
 #include "dynamap/mapping/map_backend.hpp"  // MappingError
 #include "dynamap/mapping/ply_io.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "map_metrics.hpp"
 #include "ply_colored.hpp"
 #include "test_paths.hpp"

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "app_config.hpp"
 #include "dynamap/mapping/backend_registry.hpp"
+#include "dynamap/system/app_config.hpp"
 
 namespace dynamap {
 namespace {

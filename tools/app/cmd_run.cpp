@@ -1,8 +1,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include "app_config.hpp"
 #include "commands.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "image_io.hpp"
 #include "interrupt.hpp"
 #include "output_files.hpp"

@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "json_writer.hpp"
+#include "json_io.hpp"
 #include "map_metrics.hpp"
 
 namespace dynamap {
@@ -21,15 +21,11 @@ std::string mapMetricsJson(const std::string& sequence_dir, const std::string& m
   T_ref_map.linear() = alignment.scale * alignment.R;  // scale is 1 for a rigid alignment
   T_ref_map.translation() = alignment.t;
   const MapMetrics m = computeMapMetrics(readPlyVertices(map_file.string()), refs, T_ref_map);
-  JsonObject json;
-  json.add("file", map_file.filename().string())
-      .add("map_points_1cm", static_cast<std::uint64_t>(m.map_points))
-      .add("accuracy_mean_m", m.accuracy_mean_m)
-      .add("precision", m.precision)
-      .add("completeness", m.completeness)
-      .add("fscore", m.fscore)
-      .add("ghost_ratio", m.ghost_ratio);
-  return json.str();
+  const Json json = {{"file", map_file.filename().string()}, {"map_points_1cm", m.map_points},
+                     {"accuracy_mean_m", m.accuracy_mean_m}, {"precision", m.precision},
+                     {"completeness", m.completeness},       {"fscore", m.fscore},
+                     {"ghost_ratio", m.ghost_ratio}};
+  return dumpJson(json);
 }
 
 }  // namespace dynamap

@@ -10,14 +10,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
-#include "dynamap/core/tracker.hpp"
-#include "dynamap/mapping/backend_registry.hpp"
-#include "dynamap/mapping/mapping_worker.hpp"
+#include "dynamap/system.hpp"
 #include "given_masks.hpp"
 #include "image_io.hpp"
 #include "interrupt.hpp"
 #include "output_files.hpp"
-#include "plugin_paths.hpp"
 #include "pose_lookup.hpp"
 
 namespace dynamap {
@@ -25,18 +22,13 @@ namespace dynamap {
 namespace fs = std::filesystem;
 
 struct Pipeline::Stages {
-  PinholeCamera camera;
-  std::unique_ptr<MotionFilter> motion_filter;
-  GivenMaskFilter* given_masks = nullptr;   // == motion_filter.get() with --masks
-  std::unique_ptr<Tracker> tracker;         // null with --poses
+  std::unique_ptr<System> system;
+  GivenMaskFilter* given_masks = nullptr;   // the system's motion filter with --masks
   std::unique_ptr<PoseLookup> given_poses;  // set with --poses
-  std::unique_ptr<MappingWorker> mapper;
-  std::uint64_t next_keyframe_id = 0;
 };
 
 namespace {
 
-constexpr std::size_t kMappingQueueCapacity = 16;
 constexpr double kMaxRealtimeLagS =
     0.1;  ///< --realtime: skip a frame this late if a newer one waits
 
@@ -73,34 +65,25 @@ class ProgressLine {
 Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const TumSequence& sequence)
     : options_(options), config_(config), sequence_(sequence), stages_(std::make_unique<Stages>()) {
   auto& s = *stages_;
-  s.camera = config_.resolvedCamera();
   if (fs::is_directory(fs::path(sequence_.directory()) / "mask")) {
     gt_masks_dir_ = (fs::path(sequence_.directory()) / "mask").string();
   }
-
-  // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
-  const auto registry = BackendRegistry::scan(pluginSearchPath());
-  auto backend = registry.create(config_.mapping.backend,
-                                 paramsForBackend(config_.mapping.params, config_.mapping.backend));
-  s.mapper =
-      std::make_unique<MappingWorker>(std::move(backend), s.camera, config_.mapping.static_points,
-                                      kMappingQueueCapacity, &timings_);
-
+  SystemOptions system_options;
+  system_options.drop_keyframes_when_busy = options_.realtime;
+  system_options.timings = &timings_;
   if (!options_.masks_dir.empty()) {
     if (!fs::is_directory(options_.masks_dir)) {
       throw std::runtime_error(options_.masks_dir + ": --masks folder not found");
     }
     auto given = std::make_unique<GivenMaskFilter>(options_.masks_dir);
     s.given_masks = given.get();
-    s.motion_filter = std::move(given);
+    system_options.motion_filter = std::move(given);
   }
   if (!options_.poses_file.empty()) {
     s.given_poses = std::make_unique<PoseLookup>(readTrajectory(options_.poses_file));
-    return;
+    system_options.given_poses = true;
   }
-  if (!s.motion_filter) s.motion_filter = makeMotionFilter(config_.dynamic, s.camera, &timings_);
-  s.tracker = std::make_unique<Tracker>(s.camera, config_.tracking, &timings_);
-  s.tracker->setMotionFilter(s.motion_filter.get());
+  s.system = std::make_unique<System>(config_, std::move(system_options));
 }
 
 Pipeline::~Pipeline() = default;
@@ -162,14 +145,6 @@ void Pipeline::processFrames(RunResult& result) {
   }
 }
 
-void Pipeline::pushKeyframe(KeyframePacketPtr kf, RunResult& result) {
-  if (!options_.realtime) {
-    stages_->mapper->push(std::move(kf));
-  } else if (!stages_->mapper->tryPush(std::move(kf))) {
-    ++result.counts.mapper_dropped;
-  }
-}
-
 void Pipeline::processFrame(std::size_t index, RunResult& result) {
   auto& s = *stages_;
   const SequenceEntry& entry = sequence_.entries()[index];
@@ -178,7 +153,7 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
   if (!load.ok) {
     ++result.counts.bad_frames;
     std::fprintf(stderr, "\nbad frame %zu skipped: %s\n", index, load.error.c_str());
-    if (s.tracker) s.tracker->markBadFrame(entry.rgb_timestamp_s);
+    s.system->markBadFrame(entry.rgb_timestamp_s);
     return;
   }
   const RgbdFrame& frame = load.frame;
@@ -186,59 +161,47 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
   if (s.given_poses) {  // mapping from given poses: every frame with a pose is a keyframe
     const auto pose = s.given_poses->at(frame.timestamp_s);
     if (!pose) return;
-    auto kf = std::make_shared<KeyframePacket>();
-    kf->id = s.next_keyframe_id++;
-    kf->timestamp_s = frame.timestamp_s;
-    kf->T_W_C = *pose;
-    kf->bgr = frame.bgr;
-    kf->depth_m = frame.depth_m;
+    cv::Mat mask;
     if (s.given_masks) {
       s.given_masks->setNextRgbPath(entry.rgb_path);
       s.given_masks->beginFrame(frame);
-      kf->dynamic_mask = s.given_masks->currentMask();
+      mask = s.given_masks->currentMask();
     }
-    result.trajectory.push_back({frame.timestamp_s, *pose});
-    result.frame_status.push_back("given");
-    result.keyframes.push_back({frame.timestamp_s, *pose});
-    ++result.counts.keyframes;
-    pushKeyframe(kf, result);
+    s.system->mapWithPose(frame, *pose, mask);
     return;
   }
 
   if (s.given_masks) s.given_masks->setNextRgbPath(entry.rgb_path);
-  const TrackingResult tracked = s.tracker->track(frame);
-  if (tracked.is_keyframe && tracked.keyframe) {
-    pushKeyframe(tracked.keyframe, result);
-    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, tracked, result);
-    if (options_.save_masks) writeKeyframeMask(entry, tracked);
+  const TrackOutput tracked = s.system->track(frame);
+  if (tracked.is_keyframe) {
+    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, *tracked.keyframe, result);
+    if (options_.save_masks) writeKeyframeMask(entry, *tracked.keyframe);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
-  const auto updates = s.tracker->takePoseUpdates();
-  if (!updates.empty()) s.mapper->applyPoseUpdates(updates);
 }
 
-void Pipeline::scoreKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked,
+void Pipeline::scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
                                  RunResult& result) const {
   const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
   const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (gt.empty() || gt.size() != tracked.keyframe->bgr.size()) return;  // no usable truth
-  result.mask_scores.add(scoreMask(tracked.keyframe->dynamic_mask, gt));
+  if (gt.empty() || gt.size() != keyframe.bgr.size()) return;  // no usable truth
+  result.mask_scores.add(scoreMask(keyframe.dynamic_mask, gt));
 }
 
-void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const {
+void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const {
   const fs::path dir = fs::path(options_.out_dir) / "masks";
   fs::create_directories(dir);
-  cv::Mat mask = tracked.keyframe->dynamic_mask;
-  if (mask.empty()) mask = cv::Mat::zeros(tracked.keyframe->bgr.size(), CV_8UC1);
+  cv::Mat mask = keyframe.dynamic_mask;
+  if (mask.empty()) mask = cv::Mat::zeros(keyframe.bgr.size(), CV_8UC1);
   writeImageAtomic((dir / (stampName(entry.rgb_path) + ".png")).string(), mask);
 }
 
 void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
-                               const TrackingResult& tracked) const {
+                               const TrackOutput& tracked) const {
   const fs::path dir = fs::path(options_.out_dir) / "debug";
   fs::create_directories(dir);
   // Features static/dynamic, detections and the mask, as the paper's figures show them.
-  const auto* computed = dynamic_cast<const DynamicMotionFilter*>(stages_->motion_filter.get());
+  const auto* computed = dynamic_cast<const DynamicMotionFilter*>(stages_->system->motionFilter());
   const cv::Mat picture =
       computed != nullptr
           ? drawMotionDebug(frame.bgr, computed->lastDiagnostics(), computed->classTable())
@@ -247,34 +210,27 @@ void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& fram
 }
 
 void Pipeline::finalize(RunResult& result) {
-  auto& s = *stages_;
-  if (s.tracker) {
-    s.tracker->finish();
-    const auto trajectory = s.tracker->finalTrajectory();
-    const auto statuses = s.tracker->frameStatuses();
-    for (std::size_t i = 0; i < trajectory.size(); ++i) {
-      result.trajectory.push_back({trajectory[i].first, trajectory[i].second});
-      result.frame_status.push_back(i < statuses.size() ? toString(statuses[i]) : "unknown");
-    }
-    std::vector<PoseUpdate> final_poses;
-    for (const auto& kf : s.tracker->keyframes()) {
-      result.keyframes.push_back({kf.timestamp_s, kf.T_W_C});
-      final_poses.push_back({kf.id, kf.T_W_C});
-    }
-    s.mapper->applyPoseUpdates(final_poses);
-    const TrackerStats stats = s.tracker->stats();
-    result.counts.tracked = stats.tracked;
-    result.counts.relocalized = stats.relocalized;
-    result.counts.lost = stats.lost;
-    result.counts.keyframes = stats.keyframes;
-  } else {
-    result.counts.tracked = result.trajectory.size();
+  System& system = *stages_->system;
+  system.finish();
+  const auto trajectory = system.trajectory();
+  const auto statuses = system.frameStatuses();
+  const bool given = stages_->given_poses != nullptr;
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    result.trajectory.push_back(trajectory[i]);
+    result.frame_status.push_back(given                 ? "given"
+                                  : i < statuses.size() ? toString(statuses[i])
+                                                        : "unknown");
   }
-  s.mapper->finish();
-  result.counts.mapped_keyframes = s.mapper->stats().keyframes;
+  result.keyframes = system.keyframes();
+  const SystemCounts counts = system.counts();
+  result.counts.tracked = counts.tracked;
+  result.counts.relocalized = counts.relocalized;
+  result.counts.lost = counts.lost;
+  result.counts.keyframes = counts.keyframes;
+  result.counts.mapped_keyframes = counts.mapped_keyframes;
+  result.counts.mapper_dropped = counts.mapper_dropped;
   result.map_dir = (fs::path(options_.out_dir) / "map").string();
-  fs::create_directories(result.map_dir);
-  s.mapper->exportMap(result.map_dir);
+  system.exportMap(result.map_dir);
 }
 
 }  // namespace dynamap

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "app_config.hpp"
 #include "dynamap/core/frame.hpp"
 #include "dynamap/core/timing.hpp"
+#include "dynamap/system/app_config.hpp"
 #include "mask_eval.hpp"
 #include "run_options.hpp"
 #include "trajectory_io.hpp"
@@ -14,7 +14,7 @@
 
 namespace dynamap {
 
-struct TrackingResult;
+struct TrackOutput;
 
 /// Frame counts of a run, written to run.json.
 struct RunCounts {
@@ -65,12 +65,11 @@ class Pipeline {
   void processFrames(RunResult& result);
   void processFrame(std::size_t index, RunResult& result);
   void finalize(RunResult& result);
-  void pushKeyframe(KeyframePacketPtr kf, RunResult& result);
-  void scoreKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked,
+  void scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
                          RunResult& result) const;
-  void writeKeyframeMask(const SequenceEntry& entry, const TrackingResult& tracked) const;
+  void writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
-                       const TrackingResult& tracked) const;
+                       const TrackOutput& tracked) const;
 
   RunOptions options_;
   AppConfig config_;

@@ -6,7 +6,7 @@
 
 #include "html_report.hpp"
 #include "image_io.hpp"
-#include "json_writer.hpp"
+#include "json_io.hpp"
 #include "map_report.hpp"
 #include "output_files.hpp"
 #include "trajectory_plot.hpp"
@@ -33,58 +33,46 @@ std::string framesTable(const RunResult& result) {
 }
 
 std::string timingsJson(const RunResult& result, const TimingRecorder& timings, double fps) {
-  JsonObject stages;
+  Json stages = Json::object();
   for (const auto& [name, s] : timings.allStats()) {
-    JsonObject stage;
-    stage.add("count", static_cast<std::uint64_t>(s.count))
-        .add("median_ms", s.median_ms)
-        .add("p95_ms", s.p95_ms)
-        .add("mean_ms", s.mean_ms)
-        .add("max_ms", s.max_ms);
-    stages.add(name, stage);
+    stages[name] = {{"count", s.count},
+                    {"median_ms", s.median_ms},
+                    {"p95_ms", s.p95_ms},
+                    {"mean_ms", s.mean_ms},
+                    {"max_ms", s.max_ms}};
   }
   const StageStats tracking = timings.stats("tracking");
-  JsonObject root;
-  root.add("mode", result.mode)
-      .add("frames", static_cast<std::uint64_t>(result.counts.frames_read))
-      .add("wall_time_s", result.wall_time_s)
-      .add("frames_per_s", fps)
-      .add("tracking_median_ms", tracking.median_ms)
-      .add("tracking_p95_ms", tracking.p95_ms)
-      .add("peak_memory_mib", peakMemoryMiB())
-      .add("stages", stages);
-  return root.str(2) + "\n";
-}
-
-/// {"a":1} + {"b":2} -> {"a":1, "b":2} (both must be non-empty JSON objects).
-std::string mergeJsonObjects(const std::string& a, const std::string& b) {
-  const auto a_end = a.find_last_of('}');
-  const auto b_begin = b.find('{');
-  return a.substr(0, a_end) + ", " + b.substr(b_begin + 1);
+  const Json root = {{"mode", result.mode},
+                     {"frames", result.counts.frames_read},
+                     {"wall_time_s", result.wall_time_s},
+                     {"frames_per_s", fps},
+                     {"tracking_median_ms", tracking.median_ms},
+                     {"tracking_p95_ms", tracking.p95_ms},
+                     {"peak_memory_mib", peakMemoryMiB()},
+                     {"stages", stages}};
+  return dumpJson(root, 2) + "\n";
 }
 
 }  // namespace
 
 void writeRunJson(const std::string& out_dir, const RunResult& result) {
   const RunCounts& c = result.counts;
-  JsonObject counts;
-  counts.add("frames_read", static_cast<std::uint64_t>(c.frames_read))
-      .add("tracked", static_cast<std::uint64_t>(c.tracked))
-      .add("relocalized", static_cast<std::uint64_t>(c.relocalized))
-      .add("lost", static_cast<std::uint64_t>(c.lost))
-      .add("bad_frames", static_cast<std::uint64_t>(c.bad_frames))
-      .add("keyframes", static_cast<std::uint64_t>(c.keyframes))
-      .add("mapped_keyframes", static_cast<std::uint64_t>(c.mapped_keyframes))
-      .add("skipped_realtime", static_cast<std::uint64_t>(c.skipped_realtime))
-      .add("mapper_dropped", static_cast<std::uint64_t>(c.mapper_dropped));
-  JsonObject root;
-  root.add("status", result.status)
-      .add("mode", result.mode)
-      .add("counts", counts)
-      .add("backend", result.backend);
-  if (!result.error.empty()) root.add("error", result.error);
+  const Json counts = {{"frames_read", c.frames_read},
+                       {"tracked", c.tracked},
+                       {"relocalized", c.relocalized},
+                       {"lost", c.lost},
+                       {"bad_frames", c.bad_frames},
+                       {"keyframes", c.keyframes},
+                       {"mapped_keyframes", c.mapped_keyframes},
+                       {"skipped_realtime", c.skipped_realtime},
+                       {"mapper_dropped", c.mapper_dropped}};
+  Json root = {{"status", result.status},
+               {"mode", result.mode},
+               {"counts", counts},
+               {"backend", result.backend}};
+  if (!result.error.empty()) root["error"] = result.error;
   fs::create_directories(out_dir);
-  writeTextFileAtomic((fs::path(out_dir) / "run.json").string(), root.str(2) + "\n");
+  writeTextFileAtomic((fs::path(out_dir) / "run.json").string(), dumpJson(root, 2) + "\n");
 }
 
 RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence,
@@ -99,7 +87,7 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
   writeTextFileAtomic(outPath(options, "timings.json"),
                       timingsJson(result, timings, report.frames_per_s));
 
-  std::string metrics_json;  // {"ate":…, "rpe":…, "map":…}
+  Json metrics = Json::object();  // {"ate":…, "rpe":…, "map":…, "masks":…}
   std::optional<Alignment> alignment;
   if (const auto gt_path = sequence.groundTruthPath(); gt_path && result.trajectory.size() >= 2) {
     try {
@@ -108,7 +96,7 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
       // Maps are compared after a whole-pose alignment: the ATE's position-only alignment
       // leaves the roll about a short, straight path free (alignPoses()).
       alignment = alignPoses(gt, result.trajectory, TrajectoryEvalOptions{}.max_time_diff_s);
-      metrics_json = evaluationToJson(*report.evaluation);
+      metrics.update(Json::parse(evaluationToJson(*report.evaluation)));
       TrajectoryPlotOptions plot;
       plot.title = "dynamap: " + fs::path(options.sequence_dir).filename().string();
       writeTrajectoryPlot(outPath(options, "trajectory.png"), gt, report.evaluation->ate, plot);
@@ -119,19 +107,16 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
   if (alignment && !result.map_dir.empty()) {
     try {
       report.map_metrics_json = mapMetricsJson(sequence.directory(), result.map_dir, *alignment);
-      if (!report.map_metrics_json.empty()) {
-        metrics_json = mergeJsonObjects(metrics_json, "{\"map\": " + report.map_metrics_json + "}");
-      }
+      if (!report.map_metrics_json.empty()) metrics["map"] = Json::parse(report.map_metrics_json);
     } catch (const std::exception& e) {
       report.warnings += std::string("map metrics skipped: ") + e.what() + "\n";
     }
   }
   if (result.mask_scores.frames() > 0) {
-    const std::string masks = "{\"masks\": " + result.mask_scores.toJson() + "}";
-    metrics_json = metrics_json.empty() ? masks : mergeJsonObjects(metrics_json, masks);
+    metrics["masks"] = Json::parse(result.mask_scores.toJson());
   }
-  if (!metrics_json.empty()) {
-    writeTextFileAtomic(outPath(options, "metrics.json"), metrics_json + "\n");
+  if (!metrics.empty()) {
+    writeTextFileAtomic(outPath(options, "metrics.json"), dumpJson(metrics) + "\n");
   }
   writeRunJson(options.out_dir, result);
   try {

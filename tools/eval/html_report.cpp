@@ -12,7 +12,7 @@
 #include "ate_over_time.hpp"
 #include "html_report_style.hpp"
 #include "image_io.hpp"
-#include "json_reader.hpp"
+#include "json_io.hpp"
 #include "map_preview.hpp"
 #include "ply_colored.hpp"
 #include "trajectory_eval.hpp"
@@ -27,7 +27,7 @@ constexpr std::size_t kMaxPreviewPoints = 2000000;  ///< big clouds: every k-th 
 struct ReportInputs {
   std::string out_dir;
   std::string sequence_name;
-  std::optional<JsonValue> run, metrics, timings;
+  std::optional<Json> run, metrics, timings;
   bool trajectory_plot = false;
   bool ate_plot = false;
   std::string map_file;  ///< relative to out_dir, "" when no map
@@ -40,7 +40,7 @@ std::string path(const ReportInputs& in, const std::string& name) {
   return (fs::path(in.out_dir) / name).string();
 }
 
-std::optional<JsonValue> readOptionalJson(ReportInputs* in, const std::string& name) {
+std::optional<Json> readOptionalJson(ReportInputs* in, const std::string& name) {
   const std::string file = path(*in, name);
   if (!fs::exists(file)) {
     in->notes.push_back(name + " not found");
@@ -144,21 +144,13 @@ std::string label(std::string key) {
   return key;
 }
 
-std::string format(const std::string& key, const JsonValue& v) {
+std::string format(const std::string& key, const Json& v) {
   char text[64];
-  switch (v.type()) {
-    case JsonValue::Type::kNull:
-      return "n/a";
-    case JsonValue::Type::kBool:
-      return v.asBool() ? "yes" : "no";
-    case JsonValue::Type::kString:
-      return escape(v.asString());
-    case JsonValue::Type::kNumber:
-      break;
-    default:
-      return "&hellip;";
-  }
-  const double x = v.asNumber();
+  if (v.is_null()) return "n/a";
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_string()) return escape(v.get<std::string>());
+  if (!v.is_number()) return "&hellip;";
+  const double x = v.get<double>();
   if (endsWith(key, "_per_s")) {
     std::snprintf(text, sizeof(text), "%.1f", x);
   } else if (endsWith(key, "_m")) {
@@ -182,12 +174,13 @@ std::string format(const std::string& key, const JsonValue& v) {
 }
 
 /// Two-column table of the scalar members of `object`.
-std::string keyValueTable(const std::string& caption, const JsonValue& object) {
+std::string keyValueTable(const std::string& caption, const Json& object) {
   std::ostringstream html;
   html << "<table class=\"kv\"><caption>" << escape(caption) << "</caption>\n";
-  for (const auto& [key, value] : object.members()) {
-    if (value.isObject() || value.type() == JsonValue::Type::kArray) continue;
-    html << "<tr><th>" << escape(label(key)) << "</th><td>" << format(key, value) << "</td></tr>\n";
+  for (const auto& member : object.items()) {
+    if (member.value().is_structured()) continue;
+    html << "<tr><th>" << escape(label(member.key())) << "</th><td>"
+         << format(member.key(), member.value()) << "</td></tr>\n";
   }
   html << "</table>\n";
   return html.str();
@@ -202,21 +195,23 @@ std::string runSection(const ReportInputs& in) {
   std::ostringstream html;
   html << "<section id=\"run\"><h2>Run</h2>\n";
   if (!in.run) return html.str() + "<p>run.json not available.</p></section>\n";
-  const std::string status = in.run->string("status").value_or("unknown");
+  const std::string status = stringMember(*in.run, "status").value_or("unknown");
   html << "<p>Status: <span class=\"status " << escape(status) << "\">" << escape(status)
        << "</span>";
-  if (auto backend = in.run->string("backend")) html << " &middot; backend " << escape(*backend);
+  if (auto backend = stringMember(*in.run, "backend"))
+    html << " &middot; backend " << escape(*backend);
   html << "</p>\n";
-  if (auto error = in.run->string("error")) {
+  if (auto error = stringMember(*in.run, "error")) {
     html << "<p class=\"error\">Error: " << escape(*error) << "</p>\n";
   }
-  if (const JsonValue* counts = in.run->find("counts"); counts && counts->isObject()) {
+  if (const Json* counts = findMember(*in.run, "counts"); counts && counts->is_object()) {
     html << "<table class=\"counts\"><tr>";
-    for (const auto& [key, value] : counts->members())
-      html << "<th>" << escape(label(key)) << "</th>";
+    for (const auto& member : counts->items())
+      html << "<th>" << escape(label(member.key())) << "</th>";
     html << "</tr><tr>";
-    for (const auto& [key, value] : counts->members())
-      html << "<td>" << format(key, value) << "</td>";
+    for (const auto& member : counts->items()) {
+      html << "<td>" << format(member.key(), member.value()) << "</td>";
+    }
     html << "</tr></table>\n";
   }
   return html.str() + "</section>\n";
@@ -229,8 +224,11 @@ std::string metricsSection(const ReportInputs& in) {
     return html.str() + "<p>metrics.json not available (no ground truth?).</p></section>\n";
   html << "<div class=\"row\">\n";
   // Every object of metrics.json gets a table (ate, rpe, map and whatever is added later).
-  for (const auto& [key, part] : in.metrics->members()) {
-    if (!part.isObject()) continue;
+  if (!in.metrics->is_object()) return html.str() + "</div></section>\n";
+  for (const auto& member : in.metrics->items()) {
+    const std::string& key = member.key();
+    const Json& part = member.value();
+    if (!part.is_object()) continue;
     const std::string caption = key == "ate"   ? "ATE (absolute trajectory error)"
                                 : key == "rpe" ? "RPE (relative pose error)"
                                 : key == "map" ? "Map vs reference"
@@ -266,22 +264,24 @@ std::string timingsSection(const ReportInputs& in) {
   html << "<section id=\"timings\"><h2>Timings</h2>\n";
   if (!in.timings) return html.str() + "<p>timings.json not available.</p></section>\n";
   html << keyValueTable("Whole run", *in.timings);
-  const JsonValue* stages = in.timings->find("stages");
-  if (stages == nullptr || !stages->isObject()) return html.str() + "</section>\n";
+  const Json* stages = findMember(*in.timings, "stages");
+  if (stages == nullptr || !stages->is_object()) return html.str() + "</section>\n";
   double longest = 1e-9;
-  for (const auto& [name, s] : stages->members())
-    longest = std::max(longest, s.number("p95_ms").value_or(0.0));
+  for (const auto& stage : *stages) {
+    longest = std::max(longest, numberMember(stage, "p95_ms").value_or(0.0));
+  }
   html << "<table class=\"stages\"><caption>Per stage</caption>\n<tr><th>stage</th><th>count</th>"
           "<th>median</th><th>p95</th><th>mean</th><th>max</th><th class=\"barcol\">"
           "median / p95</th></tr>\n";
-  for (const auto& [name, stage] : stages->members()) {
-    const JsonValue& s = stage;  // clang < 16 cannot capture structured bindings
+  for (const auto& member : stages->items()) {
+    const std::string& name = member.key();
+    const Json& s = member.value();
     auto cell = [&](const char* key) {
-      const JsonValue* v = s.find(key);
+      const Json* v = findMember(s, key);
       return v ? format(key, *v) : std::string("n/a");
     };
-    const double median = s.number("median_ms").value_or(0.0),
-                 p95 = s.number("p95_ms").value_or(0.0);
+    const double median = numberMember(s, "median_ms").value_or(0.0),
+                 p95 = numberMember(s, "p95_ms").value_or(0.0);
     char bars[200];
     std::snprintf(bars, sizeof(bars),
                   "<div class=\"bar p95\" style=\"width:%.1f%%\"><div class=\"bar median\" "

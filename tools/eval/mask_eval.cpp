@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "json_writer.hpp"
+#include "json_io.hpp"
 
 namespace dynamap {
 
@@ -74,14 +74,13 @@ double MaskScoreSummary::pixelRecall() const {
 }
 
 std::string MaskScoreSummary::toJson() const {
-  JsonObject o;
-  o.add("frames", static_cast<std::uint64_t>(frames_))
-      .add("frames_with_moving", static_cast<std::uint64_t>(frames_with_moving_))
-      .add("mean_iou", meanIou())
-      .add("standing_masked_share", standingMaskedShare())
-      .add("pixel_precision", pixelPrecision())
-      .add("pixel_recall", pixelRecall());
-  return o.str();
+  const Json o = {{"frames", frames_},
+                  {"frames_with_moving", frames_with_moving_},
+                  {"mean_iou", meanIou()},
+                  {"standing_masked_share", standingMaskedShare()},
+                  {"pixel_precision", pixelPrecision()},
+                  {"pixel_recall", pixelRecall()}};
+  return dumpJson(o);
 }
 
 }  // namespace dynamap

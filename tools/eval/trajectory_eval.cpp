@@ -10,7 +10,7 @@
 
 #include <Eigen/SVD>
 
-#include "json_writer.hpp"
+#include "json_io.hpp"
 #include "tum_dataset.hpp"
 
 namespace dynamap {
@@ -260,28 +260,21 @@ TrajectoryEvaluation evaluateTrajectories(const std::vector<TimedPose>& gt,
 
 std::string evaluationToJson(const TrajectoryEvaluation& evaluation) {
   const AteResult& a = evaluation.ate;
-  JsonObject ate;
-  ate.add("pairs", static_cast<std::uint64_t>(a.pairs))
-      .add("rmse_m", a.error_m.rmse)
-      .add("mean_m", a.error_m.mean)
-      .add("median_m", a.error_m.median)
-      .add("std_m", a.error_m.std_dev)
-      .add("min_m", a.error_m.min)
-      .add("max_m", a.error_m.max);
-  if (a.with_scale) ate.add("scale", a.alignment.scale);
+  Json ate = {{"pairs", a.pairs},           {"rmse_m", a.error_m.rmse},
+              {"mean_m", a.error_m.mean},   {"median_m", a.error_m.median},
+              {"std_m", a.error_m.std_dev}, {"min_m", a.error_m.min},
+              {"max_m", a.error_m.max}};
+  if (a.with_scale) ate["scale"] = a.alignment.scale;
   const RpeResult& r = evaluation.rpe;
-  JsonObject rpe;
-  rpe.add("pairs", static_cast<std::uint64_t>(r.pairs))
-      .add("delta", r.delta)
-      .add("delta_unit", toString(r.unit))
-      .add("trans_rmse_m", r.trans_m.rmse)
-      .add("trans_mean_m", r.trans_m.mean)
-      .add("trans_median_m", r.trans_m.median)
-      .add("rot_rmse_deg", r.rot_deg.rmse)
-      .add("rot_mean_deg", r.rot_deg.mean);
-  JsonObject root;
-  root.add("ate", ate).add("rpe", rpe);
-  return root.str();
+  const Json rpe = {{"pairs", r.pairs},
+                    {"delta", r.delta},
+                    {"delta_unit", toString(r.unit)},
+                    {"trans_rmse_m", r.trans_m.rmse},
+                    {"trans_mean_m", r.trans_m.mean},
+                    {"trans_median_m", r.trans_m.median},
+                    {"rot_rmse_deg", r.rot_deg.rmse},
+                    {"rot_mean_deg", r.rot_deg.mean}};
+  return dumpJson(Json{{"ate", ate}, {"rpe", rpe}});
 }
 
 std::string evaluationToTable(const TrajectoryEvaluation& evaluation) {

@@ -4,11 +4,9 @@
 
 #include <opencv2/core.hpp>
 
-namespace dynamap {
+#include "dynamap/system/atomic_file.hpp"  // writeTextFileAtomic
 
-/// Writes `content` to path + ".tmp" and renames it onto `path`, so readers never see a
-/// half-written file. Throws std::runtime_error naming the path on failure.
-void writeTextFileAtomic(const std::string& path, const std::string& content);
+namespace dynamap {
 
 /// Encodes `image` in the format given by the extension of `path` (e.g. ".png") and writes
 /// it atomically (tmp + rename). Throws std::runtime_error naming the path on failure.

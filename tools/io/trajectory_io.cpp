@@ -6,8 +6,6 @@
 #include <limits>
 #include <map>
 
-#include "image_io.hpp"
-
 namespace dynamap {
 namespace {
 
@@ -46,24 +44,6 @@ std::vector<TimedPose> readTrajectory(const std::string& path) {
   poses.reserve(by_time.size());
   for (const auto& [t, T] : by_time) poses.push_back({t, T});
   return poses;
-}
-
-std::string formatTumPose(const TimedPose& pose) {
-  const Eigen::Vector3d t = pose.T_W_C.translation();
-  const Eigen::Quaterniond q(pose.T_W_C.linear());
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp_s,
-                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  return buffer;
-}
-
-void writeTrajectory(const std::string& path, const std::vector<TimedPose>& poses) {
-  std::string text = "# timestamp tx ty tz qx qy qz qw (camera to world)\n";
-  for (const TimedPose& pose : poses) {
-    text += formatTumPose(pose);
-    text += '\n';
-  }
-  writeTextFileAtomic(path, text);
 }
 
 }  // namespace dynamap

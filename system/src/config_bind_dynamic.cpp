@@ -1,4 +1,4 @@
-#include "app_config.hpp"
+#include "dynamap/system/app_config.hpp"
 
 namespace dynamap {
 

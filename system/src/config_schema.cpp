@@ -1,4 +1,4 @@
-#include "config_schema.hpp"
+#include "dynamap/system/config_schema.hpp"
 
 #include <algorithm>
 #include <cerrno>

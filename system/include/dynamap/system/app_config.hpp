@@ -2,11 +2,11 @@
 
 #include <string>
 
-#include "config_schema.hpp"
 #include "dynamap/core/camera.hpp"
 #include "dynamap/core/dynamic_config.hpp"
 #include "dynamap/core/tracker_config.hpp"
 #include "dynamap/mapping/mapping_config.hpp"
+#include "dynamap/system/config_schema.hpp"
 
 namespace dynamap {
 

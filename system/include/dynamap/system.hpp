@@ -1,0 +1,122 @@
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/frame.hpp"
+#include "dynamap/core/motion_filter.hpp"
+#include "dynamap/core/timing.hpp"
+#include "dynamap/system/app_config.hpp"
+#include "dynamap/system/trajectory.hpp"
+
+namespace dynamap {
+
+/// What System::track() returns for one frame.
+struct TrackOutput {
+  FrameStatus status = FrameStatus::kLost;
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();  ///< camera -> world
+  /// CV_8UC1, frame-sized, 255 = moving (all zeros when nothing moves or no filter runs).
+  cv::Mat dynamic_mask;
+  bool is_keyframe = false;
+  KeyframePacketPtr keyframe;  ///< set iff is_keyframe (what the mapper received)
+};
+
+/// Frame and keyframe counts so far.
+struct SystemCounts {
+  std::size_t frames = 0;  ///< frames given to track() / mapWithPose() / markBadFrame()
+  std::size_t tracked = 0, relocalized = 0, lost = 0, bad_frames = 0;
+  std::size_t keyframes = 0;
+  std::size_t mapped_keyframes = 0;  ///< integrated by the backend (final after finish())
+  std::size_t mapper_dropped = 0;    ///< SystemOptions::drop_keyframes_when_busy only
+};
+
+/// How a System is wired beyond the typed configuration.
+struct SystemOptions {
+  /// Folders searched for backend plugins before the defaults (the folders listed in the
+  /// environment variable DYNAMAP_PLUGIN_PATH, <libdir>/dynamap and <libdir> of this library,
+  /// and the build tree's lib/).
+  std::vector<std::string> plugin_dirs;
+  /// Replaces the motion filter built from config.dynamic (e.g. masks read from disk).
+  std::unique_ptr<MotionFilter> motion_filter;
+  /// Map from given poses with mapWithPose(): no tracker is built, track() throws.
+  bool given_poses = false;
+  /// A keyframe the busy mapper cannot take is dropped (counted) instead of waited for.
+  bool drop_keyframes_when_busy = false;
+  std::size_t mapping_queue_capacity = 16;
+  /// Where every stage records its timings (borrowed; must outlive the System). Null = the
+  /// System keeps its own (timings()).
+  TimingRecorder* timings = nullptr;
+};
+
+/// dynamap as a library: tracking with motion-area removal, keyframes, dense mapping into the
+/// configured backend. `dynamap run` is a thin driver over this class.
+///
+/// Per frame, track() runs the tracker (features, dynamic regions, pose, keyframe decision),
+/// hands a new keyframe to the mapping thread and forwards bundle-adjustment corrections.
+/// finish() runs the final bundle adjustment, gives the mapper the final keyframe poses and
+/// waits for it; exportMap() writes the backend's files.
+///
+/// Threading: a System is not thread-safe. Call every method from one thread (or serialise
+/// the calls); the bundle-adjustment, detector and mapping threads it owns are internal and
+/// are joined by finish() or the destructor. Different System objects are independent.
+/// Errors: the constructor and fromConfig() throw ConfigError for configuration problems
+/// (message naming the file, line or key) and std::runtime_error for an unknown backend (the
+/// message lists the known ones) or missing detector files; track() throws
+/// std::invalid_argument for images of the wrong type or size. Tracking failures are values:
+/// TrackOutput::status.
+class System {
+ public:
+  explicit System(const AppConfig& config, SystemOptions options = {});
+  /// The configuration `dynamap run` builds: code defaults, then the YAML file `config_path`
+  /// (empty = none), then each "section.key=value" override. `effective_yaml`, when given,
+  /// receives every key with its value.
+  static std::unique_ptr<System> fromConfig(const std::string& config_path,
+                                            const std::vector<std::string>& overrides,
+                                            SystemOptions options = {},
+                                            std::string* effective_yaml = nullptr);
+  ~System();  ///< finish() if not done; joins every thread
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  /// A camera frame: `bgr` CV_8UC3; `depth` CV_16UC1 in units of camera.depth_scale per metre
+  /// or CV_32FC1 in metres (0 = no reading), same size as `bgr`. Copied; undistorted when the
+  /// camera has distortion. Throws std::invalid_argument on a wrong type or size.
+  TrackOutput track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp_s);
+  /// A prepared frame (undistorted colour CV_8UC3, depth CV_32FC1 metres); not copied.
+  TrackOutput track(const RgbdFrame& frame);
+  /// A frame that could not be read: counted, no pose.
+  void markBadFrame(double timestamp_s);
+  /// Given-pose mapping (SystemOptions::given_poses): every frame is a keyframe with pose
+  /// `T_W_C` and dynamic mask `mask` (CV_8UC1 255 = moving, may be empty).
+  TrackOutput mapWithPose(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                          const cv::Mat& mask);
+
+  /// Every tracked frame's pose: relative to its keyframe, recomposed with that keyframe's
+  /// latest optimised pose (the final trajectory after finish()).
+  std::vector<TimedPose> trajectory() const;
+  std::vector<FrameStatus> frameStatuses() const;  ///< parallel to trajectory()
+  std::vector<TimedPose> keyframes() const;        ///< latest optimised keyframe poses
+  SystemCounts counts() const;
+
+  /// Final bundle adjustment, final keyframe poses to the mapper, waits for mapping and stops
+  /// the worker threads. Idempotent; track() throws std::logic_error afterwards.
+  void finish();
+  /// finish(), then writes the backend's map files into `dir` (created if needed).
+  void exportMap(const std::string& dir);
+
+  /// Per-stage timings of every thread so far (SystemOptions::timings when given).
+  const TimingRecorder& timings() const;
+  /// The motion filter in use (may be null: dynamic.mode=off or given poses).
+  const MotionFilter* motionFilter() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynamap

@@ -1,0 +1,202 @@
+#include "dynamap/system.hpp"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
+#include "dynamap/core/tracker.hpp"
+#include "dynamap/mapping/backend_registry.hpp"
+#include "dynamap/mapping/mapping_worker.hpp"
+#include "frame_input.hpp"
+#include "plugin_paths.hpp"
+
+namespace dynamap {
+
+struct System::Impl {
+  SystemOptions options;
+  PinholeCamera camera;
+  TimingRecorder own_timings;
+  TimingRecorder* timings = &own_timings;
+  std::unique_ptr<MotionFilter> motion_filter;
+  std::unique_ptr<Tracker> tracker;  // null with given poses
+  std::unique_ptr<MappingWorker> mapper;
+  FrameInput input;
+  std::uint64_t next_keyframe_id = 0;
+  SystemCounts counts;
+  std::vector<TimedPose> given_trajectory;  // given poses only
+  bool finished = false;
+
+  void pushKeyframe(KeyframePacketPtr kf);
+};
+
+void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
+  if (!options.drop_keyframes_when_busy) {
+    mapper->push(std::move(kf));
+  } else if (!mapper->tryPush(std::move(kf))) {
+    ++counts.mapper_dropped;
+  }
+}
+
+namespace {
+
+cv::Mat maskOrZeros(const cv::Mat& mask, const cv::Size& size) {
+  return mask.empty() ? cv::Mat(cv::Mat::zeros(size, CV_8UC1)) : mask;
+}
+
+}  // namespace
+
+System::System(const AppConfig& config, SystemOptions options) : impl_(std::make_unique<Impl>()) {
+  auto& s = *impl_;
+  s.options = std::move(options);
+  if (s.options.timings != nullptr) s.timings = s.options.timings;
+  s.camera = config.resolvedCamera();
+  s.input = FrameInput(s.camera, config.camera.depth_scale);
+
+  // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
+  std::vector<std::string> dirs = s.options.plugin_dirs;
+  for (const auto& d : defaultPluginDirs()) dirs.push_back(d);
+  const auto registry = BackendRegistry::scan(dirs);
+  auto backend = registry.create(config.mapping.backend,
+                                 paramsForBackend(config.mapping.params, config.mapping.backend));
+  s.mapper =
+      std::make_unique<MappingWorker>(std::move(backend), s.camera, config.mapping.static_points,
+                                      s.options.mapping_queue_capacity, s.timings);
+  s.motion_filter = std::move(s.options.motion_filter);
+  if (s.options.given_poses) return;
+  if (!s.motion_filter) s.motion_filter = makeMotionFilter(config.dynamic, s.camera, s.timings);
+  s.tracker = std::make_unique<Tracker>(s.camera, config.tracking, s.timings);
+  s.tracker->setMotionFilter(s.motion_filter.get());
+}
+
+std::unique_ptr<System> System::fromConfig(const std::string& config_path,
+                                           const std::vector<std::string>& overrides,
+                                           SystemOptions options, std::string* effective_yaml) {
+  return std::make_unique<System>(loadAppConfig(config_path, overrides, effective_yaml),
+                                  std::move(options));
+}
+
+System::~System() {
+  try {
+    finish();
+  } catch (...) {  // a destructor must not throw; finish() already stopped what it could
+  }
+}
+
+TrackOutput System::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp_s) {
+  RgbdFrame frame = impl_->input.prepare(bgr, depth, timestamp_s);
+  frame.index = impl_->counts.frames;
+  return track(frame);
+}
+
+TrackOutput System::track(const RgbdFrame& frame) {
+  auto& s = *impl_;
+  if (!s.tracker) throw std::logic_error("System::track: built for given poses (mapWithPose)");
+  if (s.finished) throw std::logic_error("System::track: called after finish()");
+  ++s.counts.frames;
+  const TrackingResult tracked = s.tracker->track(frame);
+  TrackOutput out;
+  out.status = tracked.status;
+  out.T_W_C = tracked.T_W_C;
+  out.dynamic_mask = maskOrZeros(tracked.dynamic_mask, frame.bgr.size());
+  if (tracked.is_keyframe && tracked.keyframe) {
+    out.is_keyframe = true;
+    out.keyframe = tracked.keyframe;
+    s.pushKeyframe(tracked.keyframe);
+  }
+  const auto updates = s.tracker->takePoseUpdates();
+  if (!updates.empty()) s.mapper->applyPoseUpdates(updates);
+  return out;
+}
+
+void System::markBadFrame(double timestamp_s) {
+  auto& s = *impl_;
+  ++s.counts.frames;
+  ++s.counts.bad_frames;
+  if (s.tracker && !s.finished) s.tracker->markBadFrame(timestamp_s);
+}
+
+TrackOutput System::mapWithPose(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                                const cv::Mat& mask) {
+  auto& s = *impl_;
+  if (s.tracker) throw std::logic_error("System::mapWithPose: needs SystemOptions::given_poses");
+  if (s.finished) throw std::logic_error("System::mapWithPose: called after finish()");
+  ++s.counts.frames;
+  auto kf = std::make_shared<KeyframePacket>();
+  kf->id = s.next_keyframe_id++;
+  kf->timestamp_s = frame.timestamp_s;
+  kf->T_W_C = T_W_C;
+  kf->bgr = frame.bgr;
+  kf->depth_m = frame.depth_m;
+  kf->dynamic_mask = mask;
+  s.given_trajectory.push_back({frame.timestamp_s, T_W_C});
+  ++s.counts.keyframes;
+  s.pushKeyframe(kf);
+  TrackOutput out;
+  out.status = FrameStatus::kTracked;
+  out.T_W_C = T_W_C;
+  out.dynamic_mask = maskOrZeros(mask, frame.bgr.size());
+  out.is_keyframe = true;
+  out.keyframe = std::move(kf);
+  return out;
+}
+
+std::vector<TimedPose> System::trajectory() const {
+  if (!impl_->tracker) return impl_->given_trajectory;
+  std::vector<TimedPose> poses;
+  for (const auto& [t, T_W_C] : impl_->tracker->finalTrajectory()) poses.push_back({t, T_W_C});
+  return poses;
+}
+
+std::vector<FrameStatus> System::frameStatuses() const {
+  if (!impl_->tracker) {
+    return std::vector<FrameStatus>(impl_->given_trajectory.size(), FrameStatus::kTracked);
+  }
+  return impl_->tracker->frameStatuses();
+}
+
+std::vector<TimedPose> System::keyframes() const {
+  if (!impl_->tracker) return impl_->given_trajectory;
+  std::vector<TimedPose> poses;
+  for (const auto& kf : impl_->tracker->keyframes()) poses.push_back({kf.timestamp_s, kf.T_W_C});
+  return poses;
+}
+
+SystemCounts System::counts() const {
+  const auto& s = *impl_;
+  SystemCounts c = s.counts;
+  if (s.tracker) {
+    const TrackerStats stats = s.tracker->stats();
+    c.tracked = stats.tracked;
+    c.relocalized = stats.relocalized;
+    c.lost = stats.lost;
+    c.keyframes = stats.keyframes;
+  } else {
+    c.tracked = s.given_trajectory.size();
+  }
+  c.mapped_keyframes = s.mapper->stats().keyframes;
+  return c;
+}
+
+void System::finish() {
+  auto& s = *impl_;
+  if (s.finished) return;
+  s.finished = true;
+  if (s.tracker) {
+    s.tracker->finish();
+    std::vector<PoseUpdate> final_poses;
+    for (const auto& kf : s.tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
+    s.mapper->applyPoseUpdates(final_poses);
+  }
+  s.mapper->finish();
+}
+
+void System::exportMap(const std::string& dir) {
+  finish();
+  std::filesystem::create_directories(dir);
+  impl_->mapper->exportMap(dir);
+}
+
+const TimingRecorder& System::timings() const { return *impl_->timings; }
+const MotionFilter* System::motionFilter() const { return impl_->motion_filter.get(); }
+
+}  // namespace dynamap
