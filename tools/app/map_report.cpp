@@ -28,7 +28,9 @@ std::string mapMetricsJson(const std::string& sequence_dir, const std::string& m
       .add("precision", m.precision)
       .add("completeness", m.completeness)
       .add("fscore", m.fscore)
-      .add("ghost_ratio", m.ghost_ratio);
+      .add("ghost_ratio", m.ghost_ratio)
+      .add("ghost_fragments", static_cast<std::uint64_t>(m.ghost_fragments))
+      .add("ghost_fragment_points", static_cast<std::uint64_t>(m.ghost_fragment_points));
   return json.str();
 }
 
