@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <opencv2/imgproc.hpp>
 
@@ -121,18 +122,16 @@ class ElementTable {
     }
   }
 
-  bool removed(std::uint32_t i, std::uint32_t min_views) const {
-    return elements_[i].seen_through >= min_views;
+  /// Keys of the elements seen through by at least min_views keyframes (a small set: fast
+  /// lookups for every pixel).
+  std::unordered_set<std::uint64_t> removedKeys(std::uint32_t min_views) const {
+    std::unordered_set<std::uint64_t> keys;
+    for (const auto& [key, i] : index_) {
+      if (elements_[i].seen_through >= min_views) keys.insert(key);
+    }
+    return keys;
   }
-  std::size_t countRemoved(std::uint32_t min_views) const {
-    std::size_t n = 0;
-    for (std::uint32_t i = 0; i < elements_.size(); ++i) n += removed(i, min_views) ? 1 : 0;
-    return n;
-  }
-  /// Element of a world point (which is known to be in the table).
-  std::uint32_t find(const Eigen::Vector3f& p_W) const {
-    return index_.at(voxelKey(p_W, inv_voxel_));
-  }
+  std::uint64_t key(const Eigen::Vector3f& p_W) const { return voxelKey(p_W, inv_voxel_); }
   std::size_t size() const { return elements_.size(); }
   std::size_t bytes() const {
     const std::size_t node = sizeof(std::uint64_t) + sizeof(std::uint32_t) + 2 * sizeof(void*);
@@ -195,14 +194,15 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
   }
   const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
   result.elements = table.size();
-  result.seen_through = table.countRemoved(min_views);
+  const std::unordered_set<std::uint64_t> removed = table.removedKeys(min_views);
+  result.seen_through = removed.size();
   result.element_bytes = table.bytes();
-  if (result.seen_through == 0) return result;
+  if (removed.empty()) return result;
   for (std::size_t i = 0; i < keyframes.size(); ++i) {
     const auto t0 = Clock::now();
     if (keyframes[i].static_depth == nullptr) continue;
     forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
-      if (table.removed(table.find(p_W), min_views)) {
+      if (removed.count(table.key(p_W)) != 0) {
         depth = 0;
         ++result.removed_pixels;
       }
