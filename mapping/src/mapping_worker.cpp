@@ -162,7 +162,8 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
     sp.static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
     rec.bgr = kf.bgr;  // shared, immutable packet data
   }
-  if (options_.visibility.enabled) rec.view = makeVisibilityView(kf.depth_m, options_.visibility);
+  if (options_.visibility.enabled)
+    rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
   if (records_.emplace(kf.id, std::move(rec)).second) order_.push_back(kf.id);
   const auto early = early_updates_.find(kf.id);
   if (early != early_updates_.end()) {

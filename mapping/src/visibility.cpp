@@ -34,6 +34,8 @@ struct Element {
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   std::uint32_t count = 0;
   std::uint32_t seen_through = 0;
+  std::uint16_t observed = 0;  ///< keyframes whose surface at the projection is this element
+  std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
 };
 
 /// Runs fn(depth, u, v, p_W) for every static pixel of a keyframe.
@@ -108,6 +110,7 @@ class ElementTable {
     const auto per_m2 = static_cast<float>(options.margin_per_m2);
     const auto cap = static_cast<std::uint32_t>(std::max(1, options.min_views));
     const int w = view.near_m.cols, h = view.near_m.rows;
+    const bool has_mask = view.moving.size() == view.near_m.size();
     for (std::size_t i = 0; i < centroids_.size(); ++i) {
       const Eigen::Vector3f p = R * centroids_[i] + t;
       if (p.z() < kMinDepthM) continue;
@@ -116,18 +119,30 @@ class ElementTable {
         continue;
       const float seen = view.near_m.at<float>(static_cast<int>(vf), static_cast<int>(uf));
       if (seen <= 0.0f) continue;
-      if (p.z() < seen - margin - per_m2 * seen * seen && elements_[i].seen_through < cap) {
-        ++elements_[i].seen_through;
+      const float m = margin + per_m2 * seen * seen;
+      Element& e = elements_[i];
+      if (p.z() < seen - m) {
+        if (e.seen_through < cap) ++e.seen_through;
+      } else if (p.z() <= seen + m && e.observed < 0xffff) {
+        ++e.observed;
+        if (has_mask && view.moving.at<std::uint8_t>(static_cast<int>(vf), static_cast<int>(uf)))
+          ++e.masked;
       }
     }
   }
 
-  /// Keys of the elements seen through by at least min_views keyframes (a small set: fast
-  /// lookups for every pixel).
-  std::unordered_set<std::uint64_t> removedKeys(std::uint32_t min_views) const {
+  /// Keys of the removed elements (a small set: fast lookups for every pixel); counts those
+  /// removed by mask votes only.
+  std::unordered_set<std::uint64_t> removedKeys(const VisibilityOptions& options,
+                                                std::size_t* mask_voted) const {
+    const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
     std::unordered_set<std::uint64_t> keys;
     for (const auto& [key, i] : index_) {
-      if (elements_[i].seen_through >= min_views) keys.insert(key);
+      const Element& e = elements_[i];
+      const bool voted = options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
+                         e.masked >= options.mask_ratio * e.observed;
+      if (e.seen_through >= min_views || voted) keys.insert(key);
+      if (e.seen_through < min_views && voted) ++*mask_voted;
     }
     return keys;
   }
@@ -151,7 +166,8 @@ class ElementTable {
 
 }  // namespace
 
-VisibilityView makeVisibilityView(const cv::Mat& depth_m, const VisibilityOptions& options) {
+VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                  const VisibilityOptions& options) {
   VisibilityView view;
   view.downsample = std::max(1, options.downsample);
   if (depth_m.empty()) return view;
@@ -169,6 +185,11 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const VisibilityOption
   cv::erode(block, block, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
   block.setTo(0.0f, block >= kNoReading);
   view.near_m = block;
+  if (dynamic_mask.size() == depth_m.size() && dynamic_mask.type() == CV_8UC1) {
+    cv::Mat share;  // block mean of the moving pixels
+    cv::resize(cv::Mat(dynamic_mask == 255), share, block.size(), 0, 0, cv::INTER_AREA);
+    view.moving = share >= 128;
+  }
   return view;
 }
 
@@ -192,10 +213,9 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
     }
     result.per_keyframe_ms[j] += msSince(t0);
   }
-  const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
   result.elements = table.size();
-  const std::unordered_set<std::uint64_t> removed = table.removedKeys(min_views);
-  result.seen_through = removed.size();
+  const std::unordered_set<std::uint64_t> removed = table.removedKeys(options, &result.mask_voted);
+  result.seen_through = removed.size() - result.mask_voted;
   result.element_bytes = table.bytes();
   if (removed.empty()) return result;
   for (std::size_t i = 0; i < keyframes.size(); ++i) {

@@ -114,6 +114,48 @@ INSTANTIATE_TEST_SUITE_P(AllBackends, VisibilityAllBackends, ::testing::ValuesIn
                          [](const auto& info) { return info.param; });
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(VisibilityAllBackends);
 
+// Mask votes: a box that never moves while the camera moves (so no keyframe ever sees through
+// it) but that the masks mark as moving in all keyframes except two: most views say "mover", so
+// the two unmasked keyframes' points of it go (but for its rim); the never-masked static box stays.
+// Without the votes (mask_min_views = 0) the box stays.
+TEST(Visibility, MaskVotesRemoveWhatMostKeyframesMasked) {
+  const SyntheticScene scene;
+  const auto build = [&](int mask_min_views) {
+    StaticPointsOptions options;
+    options.visibility.mask_min_views = mask_min_views;
+    TimingRecorder timings;
+    MappingWorker worker(BackendRegistry::scan({pluginDir()}).create("points", {}),
+                         SyntheticScene::camera(), options, 2, &timings);
+    for (int k = 0; k < kFrames; ++k) {
+      const SyntheticFrame f = scene.render(k, kFrames, boxAt(0));
+      auto kf = std::make_shared<KeyframePacket>();
+      kf->id = static_cast<std::uint64_t>(k);
+      kf->T_W_C = f.T_W_C;
+      kf->bgr = f.bgr;
+      kf->depth_m = f.depth_m;
+      if (k != 3 && k != 8) kf->dynamic_mask = f.mask;
+      worker.push(kf);
+    }
+    worker.finish();
+    const fs::path dir = freshTempDir("visibility_votes_" + std::to_string(mask_min_views));
+    worker.exportMap(dir.string());
+    return readPly((dir / "cloud.ply").string()).vertices;
+  };
+  const auto on_box = [](const std::vector<Eigen::Vector3f>& map) {
+    std::size_t n = 0;
+    for (const auto& p : map) n += boxAt(0).contains(p.cast<double>(), 0.01) ? 1 : 0;
+    return n;
+  };
+  const auto voted = build(2);
+  const std::size_t without = on_box(build(0));
+  EXPECT_GT(without, 1000u);
+  // Its rim (blocks of the view less than half under the mask) may stay: at most 5 %.
+  EXPECT_LT(on_box(voted), 0.05 * without);
+  std::size_t standing = 0;
+  for (const auto& p : voted) standing += scene.static_box.distance(p.cast<double>()) < 0.01;
+  EXPECT_GT(standing, 500u);
+}
+
 // removeSeenThrough() alone: a keyframe that saw through a surface removes it, one that saw it
 // (or saw something nearer along the ray) does not; the depth image is edited in place.
 TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {
@@ -126,9 +168,9 @@ TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {
   const int box_px = cv::countNonZero(with_box.mask);
   ASSERT_GT(box_px, 200);
   VisibilityOptions options;
-  const VisibilityView v0 = makeVisibilityView(with_box.depth_m, options);
-  const VisibilityView v1 = makeVisibilityView(again.depth_m, options);
-  const VisibilityView v2 = makeVisibilityView(without_box.depth_m, options);
+  const VisibilityView v0 = makeVisibilityView(with_box.depth_m, cv::Mat(), options);
+  const VisibilityView v1 = makeVisibilityView(again.depth_m, cv::Mat(), options);
+  const VisibilityView v2 = makeVisibilityView(without_box.depth_m, cv::Mat(), options);
   std::vector<VisibilityKeyframe> kfs = {{&d0, 1.0, with_box.T_W_C, &v0},
                                          {&d1, 1.0, again.T_W_C, &v1}};
   // Two keyframes that both saw the box: nothing removed.

@@ -17,6 +17,11 @@ struct VisibilityOptions {
   int downsample = 4;           ///< depth views are kept at 1/downsample resolution
   double margin_m = 0.06;       ///< an element must lie this far in front of what a view saw...
   double margin_per_m2 = 0.02;  ///< ... plus this times depth^2 (sensor noise grows with z^2)
+  /// Mask votes (0 = off): an element that at least this many keyframes saw (their surface at
+  /// its projection within the margin) under their dynamic mask, and at least mask_ratio of
+  /// all the keyframes that saw it, is a mover one keyframe's mask missed.
+  int mask_min_views = 2;
+  double mask_ratio = 0.5;
 };
 
 /// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
@@ -25,10 +30,13 @@ struct VisibilityOptions {
 /// and small pose errors count as "not seen through".
 struct VisibilityView {
   cv::Mat near_m;  ///< CV_32FC1, 0 = no reading in the window
+  cv::Mat moving;  ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
   int downsample = 1;
 };
 
-VisibilityView makeVisibilityView(const cv::Mat& depth_m, const VisibilityOptions& options);
+/// dynamic_mask: CV_8UC1, 255 = moving (as extractStaticPoints()), or empty.
+VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                  const VisibilityOptions& options);
 
 /// One keyframe for the visibility pass: its static depth (what goes into the map; removed
 /// pixels are set to 0 in place), its final pose and its view.
@@ -41,7 +49,8 @@ struct VisibilityKeyframe {
 
 struct VisibilityResult {
   std::size_t elements = 0;      ///< voxels of the map checked
-  std::size_t seen_through = 0;  ///< of those, removed
+  std::size_t seen_through = 0;  ///< of those, removed because some keyframe saw through them
+  std::size_t mask_voted = 0;    ///< removed by mask votes only
   std::size_t removed_pixels = 0;
   std::size_t element_bytes = 0;        ///< memory of the element table during the pass
   std::vector<double> per_keyframe_ms;  ///< cost of each keyframe (build + projection + removal)
@@ -52,9 +61,10 @@ struct VisibilityResult {
 /// projected into every keyframe's view, and a voxel that at least `min_views` keyframes saw
 /// through (the view's surface at its projection lies behind it by more than margin_m +
 /// margin_per_m2 * z^2) was not there at that time: its pixels are set to 0 in every
-/// keyframe's static depth. Anything that every visit saw (a standing person, the teddy)
-/// stays. Cost: one projection of the voxel centroids per keyframe, no point pairs.
-/// Thread-safe for distinct keyframes (modifies only their depth images).
+/// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
+/// dynamic mask (options.mask_min_views, mask_ratio). Anything that every visit saw (a
+/// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
+/// point pairs. Thread-safe for distinct keyframes (modifies only their depth images).
 VisibilityResult removeSeenThrough(const PinholeCamera& camera,
                                    std::vector<VisibilityKeyframe>& keyframes,
                                    const VisibilityOptions& options);
