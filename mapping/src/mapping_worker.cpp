@@ -158,10 +158,12 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   rec.timestamp_s = kf.timestamp_s;
   rec.T_integrated = kf.T_W_C;
   rec.T_current = kf.T_W_C;
-  if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate) {
+  if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate || options_.visibility.enabled) {
     sp.static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
     rec.bgr = kf.bgr;  // shared, immutable packet data
   }
+  if (options_.visibility.enabled)
+    rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
   if (records_.emplace(kf.id, std::move(rec)).second) order_.push_back(kf.id);
   const auto early = early_updates_.find(kf.id);
   if (early != early_updates_.end()) {
@@ -171,9 +173,30 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   }
 }
 
-void MappingWorker::rebuildIfNeeded() {
-  if (backend_->poseUpdateMode() != PoseUpdateMode::kReintegrate) return;
-  bool moved = false;
+bool MappingWorker::removeSeenThroughLocked() {
+  if (!options_.visibility.enabled || order_.empty()) return false;
+  ScopedStageTimer timer(timings_, "mapping_visibility");
+  std::vector<VisibilityKeyframe> keyframes;
+  keyframes.reserve(order_.size());
+  for (const std::uint64_t id : order_) {
+    KeyframeRecord& rec = records_.at(id);
+    VisibilityKeyframe k;
+    k.static_depth = &rec.depth_u16;
+    k.metres_per_unit = 1.0 / kDepthUnitsPerM;
+    k.T_W_C = rec.T_current;
+    k.view = &rec.view;
+    keyframes.push_back(k);
+  }
+  visibility_ = removeSeenThrough(camera_, keyframes, options_.visibility);
+  if (timings_ != nullptr) {
+    for (const double ms : visibility_.per_keyframe_ms) timings_->add("mapping_visibility_kf", ms);
+  }
+  return visibility_.removed_pixels > 0;
+}
+
+void MappingWorker::rebuildIfNeeded(bool force) {
+  if (!force && backend_->poseUpdateMode() != PoseUpdateMode::kReintegrate) return;
+  bool moved = force;
   for (const auto& kv : records_) {
     moved = moved || movedBeyond(kv.second.T_integrated, kv.second.T_current,
                                  kReintegrateTranslationM, kReintegrateRotationRad);
@@ -219,12 +242,17 @@ void MappingWorker::finish() {
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   for (const auto& u : late) applyUpdateLocked(u);
-  rebuildIfNeeded();
+  rebuildIfNeeded(removeSeenThroughLocked());
 }
 
 void MappingWorker::exportMap(const std::string& dir) {
   std::lock_guard<std::mutex> lock(backend_mutex_);
   backend_->exportMap(dir);
+}
+
+VisibilityResult MappingWorker::visibilityResult() const {
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  return visibility_;
 }
 
 MapStats MappingWorker::stats() const {

@@ -17,6 +17,15 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.free_space_margin_per_m2", &s.free_space.margin_per_m2, 0.0, 10.0);
   schema.addInt("mapping.free_space_min_area_px", &s.free_space.min_area_px, 1, 1000000);
   schema.addInt("mapping.free_space_fringe_px", &s.free_space.fringe_px, 0, 100);
+  VisibilityOptions& vis = s.visibility;
+  schema.addBool("mapping.visibility_check", &vis.enabled);
+  schema.addDouble("mapping.visibility_voxel_m", &vis.voxel_m, 0.005, 1.0);
+  schema.addInt("mapping.visibility_min_views", &vis.min_views, 1, 1000);
+  schema.addInt("mapping.visibility_downsample", &vis.downsample, 1, 16);
+  schema.addDouble("mapping.visibility_margin_m", &vis.margin_m, 0.0, 10.0);
+  schema.addDouble("mapping.visibility_margin_per_m2", &vis.margin_per_m2, 0.0, 10.0);
+  schema.addInt("mapping.visibility_mask_min_views", &vis.mask_min_views, 0, 1000);
+  schema.addDouble("mapping.visibility_mask_ratio", &vis.mask_ratio, 0.0, 1.0);
 }
 
 }  // namespace dynamap

@@ -80,6 +80,30 @@ TEST(MapMetrics, DefinitionsOnASyntheticPlane) {
   EXPECT_NEAR(moved.precision, 1.0, 1e-9);
 }
 
+// Ghost fragments: 26-connected groups of >= 50 ghost points on the 1 cm grid.
+TEST(MapMetrics, GhostFragmentsAreConnectedGroupsOfAtLeast50Points) {
+  const auto refs = makeRefs(planeZ(0.0f, 0.01f), planeZ(0.5f, 0.01f));
+  std::vector<Eigen::Vector3f> map = planeZ(0.0f, 0.01f);
+  const auto patch = [&](float x0, float y0, int n, int step) {  // n x n ghosts at z = 0.5
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        map.emplace_back(x0 + 0.01f * step * i + 0.005f, y0 + 0.01f * step * j + 0.005f, 0.505f);
+  };
+  patch(0.1f, 0.1f, 8, 1);  // 64 points: a fragment
+  patch(0.5f, 0.5f, 7, 1);  // 49 points: too small
+  patch(0.1f, 0.6f, 8, 2);  // 64 points 2 cm apart: not connected
+  // Diagonal neighbours (26-connectivity): a staircase of 60 points is one fragment.
+  for (int i = 0; i < 60; ++i)
+    map.emplace_back(0.3f + 0.01f * i + 0.005f, 0.105f + 0.01f * i, 0.505f);
+  const MapMetrics m = computeMapMetrics(map, refs);
+  EXPECT_EQ(m.ghost_fragments, 2u);
+  EXPECT_EQ(m.ghost_fragment_points, 124u);
+  std::vector<Eigen::Vector3f> sheet;  // 30 x 30 voxel centres: one group of 900
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) sheet.emplace_back(0.01f * i + 0.005f, 0.01f * j + 0.005f, 0.0f);
+  EXPECT_EQ(connectedGroups(sheet, 0.01, 50), std::vector<std::size_t>{900});
+}
+
 TEST(PlyIo, ReadsAsciiAndBinaryWithExtraProperties) {
   const auto dir = freshTempDir("ply_io");
   const std::string ascii = (dir / "a.ply").string();

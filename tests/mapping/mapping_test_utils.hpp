@@ -34,11 +34,11 @@ inline BackendCase backendCase(const std::string& name) {
 /// Feeds `n` synthetic frames (with masks unless !with_mask) through a MappingWorker, optionally
 /// moves every keyframe by `shift` through pose updates, finishes and exports into `dir`.
 inline MapStats buildSyntheticMap(std::unique_ptr<MapBackend> backend, int n, bool with_mask,
-                                  const Eigen::Vector3d& shift, const std::string& dir) {
+                                  const Eigen::Vector3d& shift, const std::string& dir,
+                                  const StaticPointsOptions& options = {}) {
   const SyntheticScene scene;
   TimingRecorder timings;
-  MappingWorker worker(std::move(backend), SyntheticScene::camera(), StaticPointsOptions{}, 2,
-                       &timings);
+  MappingWorker worker(std::move(backend), SyntheticScene::camera(), options, 2, &timings);
   std::vector<PoseUpdate> updates;
   for (int k = 0; k < n; ++k) {
     SyntheticFrame f = scene.render(k, n);

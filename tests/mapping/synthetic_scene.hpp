@@ -94,11 +94,13 @@ class SyntheticScene {
     return T;
   }
 
-  SyntheticFrame render(int k, int n) const {
+  SyntheticFrame render(int k, int n) const { return render(k, n, movingBox(k)); }
+  /// Frame k with the moving box wherever the caller puts it.
+  SyntheticFrame render(int k, int n, const Box& moving) const {
     const PinholeCamera cam = camera();
     SyntheticFrame f;
     f.T_W_C = pose(k, n);
-    f.moving = movingBox(k);
+    f.moving = moving;
     f.depth_m = cv::Mat::zeros(cam.height, cam.width, CV_32FC1);
     f.bgr = cv::Mat::zeros(cam.height, cam.width, CV_8UC3);
     f.mask = cv::Mat::zeros(cam.height, cam.width, CV_8UC1);

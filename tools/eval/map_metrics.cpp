@@ -15,6 +15,13 @@ namespace {
 constexpr std::uint32_t kLeafSize = 8;
 constexpr double kCoarseDiagonal = 1.7321 * ReferenceClouds::kCoarseVoxelM + 1e-4;
 
+std::uint64_t packCell(const Eigen::Vector3i& c) {
+  const auto k = [](int v) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(v) + (1 << 20)) & ((1u << 21) - 1);
+  };
+  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
+}
+
 // Runs fn(i) for i in [0, n) on two threads (the machines have 2 cores).
 template <typename Fn>
 void parallelFor(std::size_t n, const Fn& fn) {
@@ -24,6 +31,17 @@ void parallelFor(std::size_t n, const Fn& fn) {
   });
   for (std::size_t i = half; i < n; ++i) fn(i);
   t.join();
+}
+
+// Voxel key of a point (21 bits per axis, wrapping); `cell` receives the integer voxel.
+std::uint64_t voxelKey(const Eigen::Vector3f& p, double inv, Eigen::Vector3i* cell = nullptr) {
+  Eigen::Vector3i c;
+  for (int a = 0; a < 3; ++a) {
+    // Clamped before the cast (a far point would overflow); keys wrap at 2^21 voxels.
+    c[a] = static_cast<int>(std::clamp(std::floor(p[a] * inv), -1e9, 1e9));
+  }
+  if (cell != nullptr) *cell = c;
+  return packCell(c);
 }
 
 }  // namespace
@@ -107,13 +125,7 @@ std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& 
   const double inv = 1.0 / voxel_m;
   for (const auto& p : points) {
     if (!p.allFinite()) continue;
-    const auto k = [&](float v) {
-      // Clamped before the cast (a far point would overflow int64); keys wrap at 2^21 voxels.
-      const double cell = std::clamp(std::floor(v * inv), -1e15, 1e15);
-      return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << 20)) &
-             ((1u << 21) - 1);
-    };
-    Acc& a = voxels[k(p.x()) | (k(p.y()) << 21) | (k(p.z()) << 42)];
+    Acc& a = voxels[voxelKey(p, inv)];
     a.sum += p.cast<double>();
     ++a.n;
   }
@@ -121,6 +133,41 @@ std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& 
   out.reserve(voxels.size());
   for (const auto& kv : voxels) out.emplace_back((kv.second.sum / kv.second.n).cast<float>());
   return out;
+}
+
+std::vector<std::size_t> connectedGroups(const std::vector<Eigen::Vector3f>& points, double voxel_m,
+                                         std::size_t min_points) {
+  const double inv = 1.0 / voxel_m;
+  std::unordered_map<std::uint64_t, std::pair<Eigen::Vector3i, std::size_t>> cells;  // points
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    Eigen::Vector3i c;
+    const std::uint64_t k = voxelKey(p, inv, &c);
+    auto [it, inserted] = cells.try_emplace(k, c, 0);
+    ++it->second.second;
+  }
+  std::vector<std::size_t> groups;
+  std::vector<std::uint64_t> stack;
+  while (!cells.empty()) {
+    std::size_t size = 0;
+    stack.assign(1, cells.begin()->first);
+    while (!stack.empty()) {  // flood fill, erasing visited cells
+      const auto it = cells.find(stack.back());
+      stack.pop_back();
+      if (it == cells.end()) continue;
+      const Eigen::Vector3i c = it->second.first;
+      size += it->second.second;
+      cells.erase(it);
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const std::uint64_t n = packCell(c + Eigen::Vector3i(dx, dy, dz));
+            if (cells.count(n) != 0) stack.push_back(n);
+          }
+    }
+    if (size >= min_points) groups.push_back(size);
+  }
+  return groups;
 }
 
 std::vector<Eigen::Vector3f> readPlyVertices(const std::string& path) {
@@ -181,6 +228,16 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
   m.accuracy_mean_m = sum / map.size();
   m.precision = static_cast<double>(close) / map.size();
   m.ghost_ratio = static_cast<double>(ghosts) / map.size();
+  std::vector<Eigen::Vector3f> ghost_points;
+  ghost_points.reserve(ghosts);
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    if (ghost[i] != 0) ghost_points.push_back(map[i]);
+  }
+  const auto min_points = static_cast<std::size_t>(std::max(1, options.ghost_fragment_min_points));
+  for (const std::size_t n : connectedGroups(ghost_points, options.voxel_m, min_points)) {
+    ++m.ghost_fragments;
+    m.ghost_fragment_points += n;
+  }
   if (!options.completeness) return m;
   const PointIndex map_index(map);
   std::vector<char> covered(refs.static_points.size(), 0);

@@ -52,13 +52,18 @@ struct MapMetrics {
   double completeness = 0.0;
   double fscore = 0.0;
   double ghost_ratio = 0.0;
+  /// Connected groups (26-connectivity on the voxel_m grid) of at least
+  /// MapMetricsOptions::ghost_fragment_min_points ghost points, and the points in them.
+  std::size_t ghost_fragments = 0;
+  std::size_t ghost_fragment_points = 0;
 };
 
 struct MapMetricsOptions {
-  double voxel_m = 0.01;          ///< map reduced to one centroid per voxel
-  double threshold_m = 0.05;      ///< precision / completeness / ghost static distance
-  double ghost_dynamic_m = 0.03;  ///< ghost: within this of the dynamic reference
-  bool completeness = true;       ///< false skips the (reference -> map) queries
+  double voxel_m = 0.01;               ///< map reduced to one centroid per voxel
+  double threshold_m = 0.05;           ///< precision / completeness / ghost static distance
+  double ghost_dynamic_m = 0.03;       ///< ghost: within this of the dynamic reference
+  int ghost_fragment_min_points = 50;  ///< smaller connected groups of ghosts are not fragments
+  bool completeness = true;            ///< false skips the (reference -> map) queries
   /// false: distances beyond threshold_m come from the 5 cm coarse reference (accuracy off by
   /// < 9 cm for those points; precision, completeness and ghost ratio stay exact). Much faster
   /// for maps full of far-off ghosts.
@@ -72,6 +77,11 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
                              const ReferenceClouds& refs,
                              const Eigen::Isometry3d& T_ref_map = Eigen::Isometry3d::Identity(),
                              const MapMetricsOptions& options = {});
+
+/// Connected groups of the given points on their voxel_m grid (26-connectivity; points in the
+/// same voxel are one cell): the sizes (in points) of the groups of at least min_points.
+std::vector<std::size_t> connectedGroups(const std::vector<Eigen::Vector3f>& points, double voxel_m,
+                                         std::size_t min_points);
 
 /// One centroid per voxel of size voxel_m.
 std::vector<Eigen::Vector3f> voxelCentroids(const std::vector<Eigen::Vector3f>& points,

@@ -25,7 +25,11 @@ namespace dynamap {
 /// keyframe's static depth (16-bit, 0.2 mm) and colour. With options.free_space enabled, a
 /// keyframe is integrated once its `neighbours` later keyframes have arrived (or at finish()),
 /// without the pixels that lie in free space seen by up to `neighbours` keyframes on each side
-/// (freeSpaceViolations(): movers the masks missed). All public methods are thread-safe;
+/// (freeSpaceViolations(): movers the masks missed). With options.visibility enabled, finish()
+/// checks every map element against every keyframe with the final poses (removeSeenThrough():
+/// what any keyframe saw through is removed) and rebuilds the map without it, whatever the
+/// backend; for that it keeps every keyframe's static depth, colour and a 1/downsample
+/// resolution view of its depth (VisibilityView). All public methods are thread-safe;
 /// exportMap() and stats() after finish() see the final map.
 class MappingWorker {
  public:
@@ -51,6 +55,8 @@ class MappingWorker {
   std::size_t droppedKeyframes() const { return dropped_.load(); }
   /// Keyframes re-integrated by the final rebuild (0 if none was needed).
   std::size_t reintegratedKeyframes() const;
+  /// The visibility pass of finish() (all zero before finish() or when it is disabled).
+  VisibilityResult visibilityResult() const;
 
  private:
   struct KeyframeRecord {
@@ -59,6 +65,7 @@ class MappingWorker {
     Eigen::Isometry3d T_current = Eigen::Isometry3d::Identity();
     cv::Mat depth_u16;  ///< static depth, 1/5000 m
     cv::Mat bgr;
+    VisibilityView view;  ///< options.visibility enabled only
   };
   struct WindowEntry {
     KeyframePacketPtr kf;
@@ -70,7 +77,10 @@ class MappingWorker {
   /// (all of them when `flush`).
   void advanceWindow(KeyframePacketPtr kf, bool flush);
   void integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask);
-  void rebuildIfNeeded();
+  /// Rebuilds when a volumetric backend's keyframe moved, or always when `force`.
+  void rebuildIfNeeded(bool force);
+  /// The visibility pass over all keyframes; true if it removed pixels.
+  bool removeSeenThroughLocked();
   void applyUpdateLocked(const PoseUpdate& update);
 
   std::unique_ptr<MapBackend> backend_;
@@ -94,6 +104,7 @@ class MappingWorker {
   std::vector<std::uint64_t> order_;
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
+  VisibilityResult visibility_;
   std::thread thread_;
 };
 

@@ -9,6 +9,7 @@
 
 #include "dynamap/core/camera.hpp"
 #include "dynamap/mapping/free_space.hpp"
+#include "dynamap/mapping/visibility.hpp"
 
 namespace dynamap {
 
@@ -18,7 +19,8 @@ struct StaticPointsOptions {
   int mask_dilation_px = 5;              ///< dynamic mask grown by this radius (0 = as is)
   double depth_edge_threshold_m = 0.05;  ///< |depth jump| to a 4-neighbour marking an edge
   int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
-  FreeSpaceOptions free_space;  ///< MappingWorker: drop pixels that violate neighbours' free space
+  FreeSpaceOptions free_space;   ///< MappingWorker: drop pixels that violate neighbours' free space
+  VisibilityOptions visibility;  ///< MappingWorker::finish(): drop what any keyframe saw through
 };
 
 /// The static part of one RGB-D keyframe. The only place where masks become map input.

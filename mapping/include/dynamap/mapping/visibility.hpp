@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/camera.hpp"
+
+namespace dynamap {
+
+struct VisibilityOptions {
+  bool enabled = true;
+  double voxel_m = 0.02;        ///< map elements: centroids of the static points per voxel
+  int min_views = 1;            ///< keyframes that must have seen through an element
+  int downsample = 4;           ///< depth views are kept at 1/downsample resolution
+  double margin_m = 0.06;       ///< an element must lie this far in front of what a view saw...
+  double margin_per_m2 = 0.02;  ///< ... plus this times depth^2 (sensor noise grows with z^2)
+  /// Mask votes (0 = off): an element that at least this many keyframes saw (their surface at
+  /// its projection within the margin) under their dynamic mask, and at least mask_ratio of
+  /// all the keyframes that saw it, is a mover one keyframe's mask missed.
+  int mask_min_views = 2;
+  double mask_ratio = 0.5;
+};
+
+/// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
+/// (movers included) in a window of 3 x `downsample` pixels, at 1/downsample resolution (a
+/// 160 x 120 float image for 640 x 480 and downsample 4: 77 KB). The window makes depth edges
+/// and small pose errors count as "not seen through".
+struct VisibilityView {
+  cv::Mat near_m;  ///< CV_32FC1, 0 = no reading in the window
+  cv::Mat moving;  ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
+  int downsample = 1;
+};
+
+/// dynamic_mask: CV_8UC1, 255 = moving (as extractStaticPoints()), or empty.
+VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                  const VisibilityOptions& options);
+
+/// One keyframe for the visibility pass: its static depth (what goes into the map; removed
+/// pixels are set to 0 in place), its final pose and its view.
+struct VisibilityKeyframe {
+  cv::Mat* static_depth = nullptr;  ///< CV_32FC1 or CV_16UC1, 0 = not in the map
+  double metres_per_unit = 1.0;     ///< depth scale (1 for metres, 1/5000 for TUM 16-bit)
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  const VisibilityView* view = nullptr;
+};
+
+struct VisibilityResult {
+  std::size_t elements = 0;      ///< voxels of the map checked
+  std::size_t seen_through = 0;  ///< of those, removed because some keyframe saw through them
+  std::size_t mask_voted = 0;    ///< removed by mask votes only
+  std::size_t removed_pixels = 0;
+  std::size_t element_bytes = 0;        ///< memory of the element table during the pass
+  std::vector<double> per_keyframe_ms;  ///< cost of each keyframe (build + projection + removal)
+};
+
+/// Visibility over all keyframes with their final poses (in the spirit of Removert / ERASOR):
+/// the static points of every keyframe are gathered into voxels (centroids), every voxel is
+/// projected into every keyframe's view, and a voxel that at least `min_views` keyframes saw
+/// through (the view's surface at its projection lies behind it by more than margin_m +
+/// margin_per_m2 * z^2) was not there at that time: its pixels are set to 0 in every
+/// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
+/// dynamic mask (options.mask_min_views, mask_ratio). Anything that every visit saw (a
+/// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
+/// point pairs. Thread-safe for distinct keyframes (modifies only their depth images).
+VisibilityResult removeSeenThrough(const PinholeCamera& camera,
+                                   std::vector<VisibilityKeyframe>& keyframes,
+                                   const VisibilityOptions& options);
+
+}  // namespace dynamap

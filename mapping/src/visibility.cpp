@@ -1,0 +1,235 @@
+#include "dynamap/mapping/visibility.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <opencv2/imgproc.hpp>
+
+namespace dynamap {
+namespace {
+
+constexpr float kNoReading = 1e9f;
+constexpr double kMinDepthM = 0.1;  // elements nearer to a camera than this are not checked
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// 21 bits per axis (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
+std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
+  const auto k = [inv_voxel](float v) {
+    const double cell = std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15);
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << 20)) &
+           ((1u << 21) - 1);
+  };
+  return k(p.x()) | (k(p.y()) << 21) | (k(p.z()) << 42);
+}
+
+struct Element {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  std::uint32_t count = 0;
+  std::uint32_t seen_through = 0;
+  std::uint16_t observed = 0;  ///< keyframes whose surface at the projection is this element
+  std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
+};
+
+/// Runs fn(depth, u, v, p_W) for every static pixel of a keyframe.
+template <typename T, typename Fn>
+void forEachStaticPointT(const PinholeCamera& camera, const VisibilityKeyframe& kf, const Fn& fn) {
+  const Eigen::Isometry3f pose = kf.T_W_C.cast<float>();
+  cv::Mat& depth = *kf.static_depth;
+  const auto scale = static_cast<float>(kf.metres_per_unit);
+  const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  for (int v = 0; v < depth.rows; ++v) {
+    T* row = depth.ptr<T>(v);
+    const float y_n = (static_cast<float>(v) - cy) / fy;
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = static_cast<float>(row[u]) * scale;
+      if (!(z > 0.0f)) continue;
+      fn(row[u], pose * Eigen::Vector3f((static_cast<float>(u) - cx) / fx * z, y_n * z, z));
+    }
+  }
+}
+template <typename Fn>
+void forEachStaticPoint(const PinholeCamera& camera, const VisibilityKeyframe& kf, const Fn& fn) {
+  if (kf.static_depth->type() == CV_16UC1) {
+    forEachStaticPointT<std::uint16_t>(camera, kf, fn);
+  } else {
+    forEachStaticPointT<float>(camera, kf, fn);
+  }
+}
+
+class ElementTable {
+ public:
+  explicit ElementTable(double voxel_m) : inv_voxel_(static_cast<float>(1.0 / voxel_m)) {}
+
+  /// Adds a keyframe's points: sorted by voxel, one hash access per distinct voxel.
+  void add(const PinholeCamera& camera, const VisibilityKeyframe& kf) {
+    keyed_.clear();
+    points_.clear();
+    forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
+      keyed_.emplace_back(voxelKey(p_W, inv_voxel_), static_cast<std::uint32_t>(points_.size()));
+      points_.push_back(p_W);
+    });
+    std::sort(keyed_.begin(), keyed_.end());
+    for (std::size_t b = 0; b < keyed_.size();) {
+      const auto [it, inserted] =
+          index_.try_emplace(keyed_[b].first, static_cast<std::uint32_t>(elements_.size()));
+      if (inserted) elements_.emplace_back();
+      Element& e = elements_[it->second];
+      for (; b < keyed_.size() && keyed_[b].first == it->first; ++b) {
+        e.sum += points_[keyed_[b].second];
+        ++e.count;
+      }
+    }
+  }
+
+  void computeCentroids() {
+    centroids_.resize(elements_.size());
+    for (std::size_t i = 0; i < elements_.size(); ++i) {
+      centroids_[i] = elements_[i].sum / static_cast<float>(elements_[i].count);
+    }
+  }
+
+  /// Counts, for every element, whether this view saw through it.
+  void project(const PinholeCamera& camera, const VisibilityView& view,
+               const Eigen::Isometry3d& T_W_C, const VisibilityOptions& options) {
+    const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
+    const Eigen::Matrix3f R = T_C_W.linear();
+    const Eigen::Vector3f t = T_C_W.translation();
+    const float s = 1.0f / static_cast<float>(view.downsample);
+    const auto fx = static_cast<float>(camera.fx) * s, fy = static_cast<float>(camera.fy) * s;
+    const auto cx = static_cast<float>(camera.cx) * s, cy = static_cast<float>(camera.cy) * s;
+    const auto margin = static_cast<float>(options.margin_m);
+    const auto per_m2 = static_cast<float>(options.margin_per_m2);
+    const auto cap = static_cast<std::uint32_t>(std::max(1, options.min_views));
+    const int w = view.near_m.cols, h = view.near_m.rows;
+    const bool has_mask = view.moving.size() == view.near_m.size();
+    for (std::size_t i = 0; i < centroids_.size(); ++i) {
+      const Eigen::Vector3f p = R * centroids_[i] + t;
+      if (p.z() < kMinDepthM) continue;
+      const float uf = fx * p.x() / p.z() + cx, vf = fy * p.y() / p.z() + cy;
+      if (!(uf >= 0.0f && vf >= 0.0f && uf < static_cast<float>(w) && vf < static_cast<float>(h)))
+        continue;
+      const float seen = view.near_m.at<float>(static_cast<int>(vf), static_cast<int>(uf));
+      if (seen <= 0.0f) continue;
+      const float m = margin + per_m2 * seen * seen;
+      Element& e = elements_[i];
+      if (p.z() < seen - m) {
+        if (e.seen_through < cap) ++e.seen_through;
+      } else if (p.z() <= seen + m && e.observed < 0xffff) {
+        ++e.observed;
+        if (has_mask && view.moving.at<std::uint8_t>(static_cast<int>(vf), static_cast<int>(uf)))
+          ++e.masked;
+      }
+    }
+  }
+
+  /// Keys of the removed elements (a small set: fast lookups for every pixel); counts those
+  /// removed by mask votes only.
+  std::unordered_set<std::uint64_t> removedKeys(const VisibilityOptions& options,
+                                                std::size_t* mask_voted) const {
+    const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
+    std::unordered_set<std::uint64_t> keys;
+    for (const auto& [key, i] : index_) {
+      const Element& e = elements_[i];
+      const bool voted = options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
+                         e.masked >= options.mask_ratio * e.observed;
+      if (e.seen_through >= min_views || voted) keys.insert(key);
+      if (e.seen_through < min_views && voted) ++*mask_voted;
+    }
+    return keys;
+  }
+  std::uint64_t key(const Eigen::Vector3f& p_W) const { return voxelKey(p_W, inv_voxel_); }
+  std::size_t size() const { return elements_.size(); }
+  std::size_t bytes() const {
+    const std::size_t node = sizeof(std::uint64_t) + sizeof(std::uint32_t) + 2 * sizeof(void*);
+    return elements_.capacity() * sizeof(Element) +
+           centroids_.capacity() * sizeof(Eigen::Vector3f) + index_.size() * node +
+           index_.bucket_count() * sizeof(void*);
+  }
+
+ private:
+  float inv_voxel_;
+  std::unordered_map<std::uint64_t, std::uint32_t> index_;
+  std::vector<Element> elements_;
+  std::vector<Eigen::Vector3f> centroids_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;  // scratch
+  std::vector<Eigen::Vector3f> points_;                         // scratch
+};
+
+}  // namespace
+
+VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                  const VisibilityOptions& options) {
+  VisibilityView view;
+  view.downsample = std::max(1, options.downsample);
+  if (depth_m.empty()) return view;
+  const int f = view.downsample;
+  cv::Mat d = depth_m.clone();
+  d.setTo(kNoReading, ~(d > 0.0f));
+  cv::Mat block(depth_m.rows / f, depth_m.cols / f, CV_32FC1);
+  for (int v = 0; v < block.rows; ++v) {
+    for (int u = 0; u < block.cols; ++u) {
+      double lo = 0.0;
+      cv::minMaxLoc(d(cv::Rect(u * f, v * f, f, f)), &lo);
+      block.at<float>(v, u) = static_cast<float>(lo);
+    }
+  }
+  cv::erode(block, block, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  block.setTo(0.0f, block >= kNoReading);
+  view.near_m = block;
+  if (dynamic_mask.size() == depth_m.size() && dynamic_mask.type() == CV_8UC1) {
+    cv::Mat share;  // block mean of the moving pixels
+    cv::resize(cv::Mat(dynamic_mask == 255), share, block.size(), 0, 0, cv::INTER_AREA);
+    view.moving = share >= 128;
+  }
+  return view;
+}
+
+VisibilityResult removeSeenThrough(const PinholeCamera& camera,
+                                   std::vector<VisibilityKeyframe>& keyframes,
+                                   const VisibilityOptions& options) {
+  VisibilityResult result;
+  result.per_keyframe_ms.assign(keyframes.size(), 0.0);
+  ElementTable table(options.voxel_m);
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    const auto t0 = Clock::now();
+    if (keyframes[i].static_depth != nullptr) table.add(camera, keyframes[i]);
+    result.per_keyframe_ms[i] += msSince(t0);
+  }
+  table.computeCentroids();
+  for (std::size_t j = 0; j < keyframes.size(); ++j) {
+    const auto t0 = Clock::now();
+    const VisibilityView* view = keyframes[j].view;
+    if (view != nullptr && !view->near_m.empty()) {
+      table.project(camera, *view, keyframes[j].T_W_C, options);
+    }
+    result.per_keyframe_ms[j] += msSince(t0);
+  }
+  result.elements = table.size();
+  const std::unordered_set<std::uint64_t> removed = table.removedKeys(options, &result.mask_voted);
+  result.seen_through = removed.size() - result.mask_voted;
+  result.element_bytes = table.bytes();
+  if (removed.empty()) return result;
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    const auto t0 = Clock::now();
+    if (keyframes[i].static_depth == nullptr) continue;
+    forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
+      if (removed.count(table.key(p_W)) != 0) {
+        depth = 0;
+        ++result.removed_pixels;
+      }
+    });
+    result.per_keyframe_ms[i] += msSince(t0);
+  }
+  return result;
+}
+
+}  // namespace dynamap

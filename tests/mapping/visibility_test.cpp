@@ -1,0 +1,192 @@
+// The visibility pass (visibility.hpp, MappingWorker::finish()) over every backend: the synthetic
+// room where the floating box stands still, unmasked, for the first half of the keyframes (a
+// mover the masks missed), then moves away with masks, except one keyframe whose mask is
+// missing too. The 2 + 2 neighbour free-space check cannot see through the box in its first
+// keyframes (all their neighbours saw it there); later keyframes can. The static box on the floor
+// is never masked and never moves (a standing person): it must stay.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "dynamap/mapping/ply_io.hpp"
+#include "dynamap/mapping/visibility.hpp"
+#include "map_metrics.hpp"
+#include "mapping_test_utils.hpp"
+
+namespace dynamap::test {
+namespace {
+
+constexpr int kFrames = 12;
+constexpr int kStillUntil = 6;    // frames [0, 6): the box stands at movingBox(0), no mask
+constexpr int kUnmaskedLate = 7;  // a later frame whose mask is missing as well
+namespace fs = std::filesystem;
+
+Box boxAt(int k) { return SyntheticScene::movingBox(k < kStillUntil ? 0 : k); }
+bool masked(int k) { return k >= kStillUntil && k != kUnmaskedLate; }
+
+/// Map of the scene; `all_masks` gives every frame its mask (the reference).
+std::vector<Eigen::Vector3f> buildMap(const std::string& backend,
+                                      const StaticPointsOptions& options, bool all_masks,
+                                      const std::string& name) {
+  const auto registry = BackendRegistry::scan({pluginDir()});
+  const SyntheticScene scene;
+  TimingRecorder timings;
+  MappingWorker worker(registry.create(backend, backendCase(backend).params),
+                       SyntheticScene::camera(), options, 2, &timings);
+  for (int k = 0; k < kFrames; ++k) {
+    const SyntheticFrame f = scene.render(k, kFrames, boxAt(k));
+    auto kf = std::make_shared<KeyframePacket>();
+    kf->id = static_cast<std::uint64_t>(k);
+    kf->timestamp_s = 0.1 * k;
+    kf->T_W_C = f.T_W_C;
+    kf->bgr = f.bgr;
+    kf->depth_m = f.depth_m;
+    if (all_masks || masked(k)) kf->dynamic_mask = f.mask;
+    worker.push(kf);
+  }
+  worker.finish();
+  const fs::path dir = freshTempDir("visibility_" + backend + "_" + name);
+  worker.exportMap(dir.string());
+  return readPly(scoredFile(dir.string())).vertices;
+}
+
+/// Map points on the box where it stood unmasked (within `margin`) and off the static geometry.
+std::size_t ghostPoints(const std::vector<Eigen::Vector3f>& map, double margin) {
+  const SyntheticScene scene;
+  std::size_t n = 0;
+  for (const auto& p : map) {
+    const Eigen::Vector3d q = p.cast<double>();
+    const bool on_box = boxAt(0).contains(q, margin) || boxAt(kUnmaskedLate).contains(q, margin);
+    n += on_box && scene.staticDistance(q) > margin ? 1 : 0;
+  }
+  return n;
+}
+
+/// Share of the reference points with a map point within `tol`.
+double coverage(const std::vector<Eigen::Vector3f>& reference,
+                const std::vector<Eigen::Vector3f>& map, double tol) {
+  if (reference.empty()) return 0.0;
+  const PointIndex index(map);
+  std::size_t covered = 0;
+  const auto t = static_cast<float>(tol);
+  for (const auto& r : reference) covered += index.nearestDistance(r, t) <= t ? 1 : 0;
+  return static_cast<double>(covered) / reference.size();
+}
+
+std::vector<std::string> backendNames() { return BackendRegistry::scan({pluginDir()}).names(); }
+
+class VisibilityAllBackends : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(VisibilityAllBackends, MissedMoverIsRemovedAndStaticGeometryStays) {
+  const std::string backend = GetParam();
+  const double voxel = backendCase(backend).voxel_m;
+  StaticPointsOptions reference_options;
+  reference_options.visibility.enabled = false;
+  reference_options.free_space.enabled = false;
+  const auto reference = buildMap(backend, reference_options, true, "reference");
+  ASSERT_GT(reference.size(), 100u);
+  ASSERT_EQ(ghostPoints(reference, voxel), 0u);
+
+  const auto map = buildMap(backend, StaticPointsOptions{}, false, "default");
+  EXPECT_EQ(ghostPoints(map, voxel), 0u) << backend << ": the box where it stood unmasked";
+  // All the static geometry the fully masked map has, the static box included.
+  EXPECT_GT(coverage(reference, map, 2.0 * voxel), 0.99) << backend;
+  std::vector<Eigen::Vector3f> static_box;
+  const SyntheticScene scene;
+  for (const auto& p : reference) {
+    if (scene.static_box.distance(p.cast<double>()) < voxel) static_box.push_back(p);
+  }
+  ASSERT_GT(static_box.size(), 10u);
+  EXPECT_GT(coverage(static_box, map, 2.0 * voxel), 0.99) << backend << ": the standing box";
+}
+
+// Shows the test above can fail: without the visibility pass (free-space check alone) the box
+// where it stood unmasked stays in every backend's map.
+TEST_P(VisibilityAllBackends, WithoutTheVisibilityPassTheMoverStays) {
+  const std::string backend = GetParam();
+  StaticPointsOptions options;
+  options.visibility.enabled = false;
+  const auto map = buildMap(backend, options, false, "off");
+  EXPECT_GT(ghostPoints(map, backendCase(backend).voxel_m), 0u) << backend;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllBackends, VisibilityAllBackends, ::testing::ValuesIn(backendNames()),
+                         [](const auto& info) { return info.param; });
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(VisibilityAllBackends);
+
+// Mask votes: a box that never moves while the camera moves (so no keyframe ever sees through
+// it) but that the masks mark as moving in all keyframes except two: most views say "mover", so
+// the two unmasked keyframes' points of it go (but for its rim); the never-masked static box stays.
+// Without the votes (mask_min_views = 0) the box stays.
+TEST(Visibility, MaskVotesRemoveWhatMostKeyframesMasked) {
+  const SyntheticScene scene;
+  const auto build = [&](int mask_min_views) {
+    StaticPointsOptions options;
+    options.visibility.mask_min_views = mask_min_views;
+    TimingRecorder timings;
+    MappingWorker worker(BackendRegistry::scan({pluginDir()}).create("points", {}),
+                         SyntheticScene::camera(), options, 2, &timings);
+    for (int k = 0; k < kFrames; ++k) {
+      const SyntheticFrame f = scene.render(k, kFrames, boxAt(0));
+      auto kf = std::make_shared<KeyframePacket>();
+      kf->id = static_cast<std::uint64_t>(k);
+      kf->T_W_C = f.T_W_C;
+      kf->bgr = f.bgr;
+      kf->depth_m = f.depth_m;
+      if (k != 3 && k != 8) kf->dynamic_mask = f.mask;
+      worker.push(kf);
+    }
+    worker.finish();
+    const fs::path dir = freshTempDir("visibility_votes_" + std::to_string(mask_min_views));
+    worker.exportMap(dir.string());
+    return readPly((dir / "cloud.ply").string()).vertices;
+  };
+  const auto on_box = [](const std::vector<Eigen::Vector3f>& map) {
+    std::size_t n = 0;
+    for (const auto& p : map) n += boxAt(0).contains(p.cast<double>(), 0.01) ? 1 : 0;
+    return n;
+  };
+  const auto voted = build(2);
+  const std::size_t without = on_box(build(0));
+  EXPECT_GT(without, 1000u);
+  // Its rim (blocks of the view less than half under the mask) may stay: at most 5 %.
+  EXPECT_LT(on_box(voted), 0.05 * without);
+  std::size_t standing = 0;
+  for (const auto& p : voted) standing += scene.static_box.distance(p.cast<double>()) < 0.01;
+  EXPECT_GT(standing, 500u);
+}
+
+// removeSeenThrough() alone: a keyframe that saw through a surface removes it, one that saw it
+// (or saw something nearer along the ray) does not; the depth image is edited in place.
+TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {
+  const PinholeCamera cam = SyntheticScene::camera();
+  const SyntheticScene scene;
+  const SyntheticFrame with_box = scene.render(0, 4, boxAt(0));
+  const SyntheticFrame without_box = scene.render(3, 4, Box{{9, 9, 9}, {9.1, 9.1, 9.1}});
+  const SyntheticFrame again = scene.render(1, 4, boxAt(0));
+  cv::Mat d0 = with_box.depth_m.clone(), d1 = again.depth_m.clone();
+  const int box_px = cv::countNonZero(with_box.mask);
+  ASSERT_GT(box_px, 200);
+  VisibilityOptions options;
+  const VisibilityView v0 = makeVisibilityView(with_box.depth_m, cv::Mat(), options);
+  const VisibilityView v1 = makeVisibilityView(again.depth_m, cv::Mat(), options);
+  const VisibilityView v2 = makeVisibilityView(without_box.depth_m, cv::Mat(), options);
+  std::vector<VisibilityKeyframe> kfs = {{&d0, 1.0, with_box.T_W_C, &v0},
+                                         {&d1, 1.0, again.T_W_C, &v1}};
+  // Two keyframes that both saw the box: nothing removed.
+  EXPECT_EQ(removeSeenThrough(cam, kfs, options).removed_pixels, 0u);
+  EXPECT_EQ(cv::countNonZero(d0 != with_box.depth_m), 0);
+  // A third one that saw through where the box was: the box goes, in both, and only the box.
+  cv::Mat d2 = without_box.depth_m.clone();
+  kfs.push_back({&d2, 1.0, without_box.T_W_C, &v2});
+  const VisibilityResult r = removeSeenThrough(cam, kfs, options);
+  EXPECT_GT(r.seen_through, 0u);
+  const cv::Mat removed0 = (d0 == 0) & (with_box.depth_m > 0);
+  EXPECT_GT(cv::countNonZero(removed0 & with_box.mask), 0.9 * box_px);
+  EXPECT_LT(cv::countNonZero(removed0 & ~with_box.mask), 0.02 * box_px);
+  EXPECT_EQ(cv::countNonZero(d2 != without_box.depth_m), 0);
+  EXPECT_EQ(r.per_keyframe_ms.size(), 3u);
+}
+
+}  // namespace
+}  // namespace dynamap::test
