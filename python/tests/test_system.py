@@ -54,7 +54,11 @@ def test_float_metres_depth_matches_uint16(teddy):
     a, b = dynamap.System(overrides=FAST), dynamap.System(overrides=FAST)
     for t, bgr, depth in frames:
         pa = a.track(bgr, depth, t).pose
-        pb = b.track(bgr, depth.astype(np.float32) / np.float32(5000.0), t).pose
+        # The same metres as cv::Mat::convertTo(CV_32F, 1.0 / 5000) computes (a float product
+        # with the float scale); a division differs in the last bit on 30 % of the values, and
+        # the tracker's RANSAC decisions may amplify that to millimetres.
+        metres = depth.astype(np.float32) * np.float32(1.0 / 5000.0)
+        pb = b.track(bgr, metres, t).pose
         np.testing.assert_allclose(pa, pb, atol=1e-5)
     assert a.counts["frames"] == 8
 

@@ -175,3 +175,56 @@ TEST(FusionOverTime, OnlyProvenStaticPointsCarveAMovingRegion) {
 
 }  // namespace
 }  // namespace dynamap
+
+namespace dynamap {
+namespace {
+
+TEST(FusionOverTime, APersonWithoutPointsIsKeptWhenItsWorldPositionStaysPut) {
+  // A plain jacket: no tracked point on it, so only its world position can tell. Still for
+  // static_confirm_frames frames (pose known): kept.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(4.f));
+  const cv::Rect person(300, 150, 80, 250);
+  depth(person).setTo(2.5f);
+  const std::vector<cv::Point2f> none;
+  const std::vector<std::uint8_t> no_flags;
+  DynamicConfig c;
+  RegionFusion fusion(c, ClassTable(c));
+  FusionEvidence ev;
+  ev.has_pose = true;
+  ev.K = cv::Vec4d(535.4, 539.2, 320.1, 247.6);
+  const Detection det{cv::Rect2f(290, 140, 100, 270), 0, 0.9f};
+  FusionResult r;
+  for (int i = 0; i <= c.static_confirm_frames; ++i)
+    r = fusion.fuse(FusionMode::kBoth, depth, none, no_flags, {det}, ev);
+  EXPECT_FALSE(r.objects.at(0).moving);
+  // Without a pose there is no evidence at all: it stays masked.
+  RegionFusion blind(c, ClassTable(c));
+  for (int i = 0; i <= 2 * c.static_confirm_frames; ++i)
+    r = blind.fuse(FusionMode::kBoth, depth, none, no_flags, {det});
+  EXPECT_TRUE(r.objects.at(0).moving);
+}
+
+TEST(FusionOverTime, OneObjectWithTwoLabelsTakesItsBetterScoredClass) {
+  // The detector calls the teddy "teddy bear" 0.8 and "person" 0.3: it is not a person.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(4.f));
+  const cv::Rect teddy(200, 150, 160, 200);
+  depth(teddy).setTo(1.5f);
+  DynamicConfig c;
+  const ClassTable classes(c);
+  RegionFusion fusion(c, classes);
+  const Detection bear{cv::Rect2f(190, 140, 180, 220), 77, 0.8f};  // COCO 77 = teddy bear
+  const Detection as_person{cv::Rect2f(195, 145, 175, 210), 0, 0.3f};
+  ASSERT_FALSE(classes.isHighDynamic(77));
+  const FusionResult r = fusion.fuse(FusionMode::kBoth, depth, {}, {}, {bear, as_person});
+  ASSERT_EQ(r.objects.size(), 1u);
+  EXPECT_EQ(r.objects[0].detection.class_id, 77);
+  EXPECT_EQ(cv::countNonZero(r.mask(teddy)), 0);
+  // A better-scored person next to a chair is still a person.
+  const Detection chair{cv::Rect2f(190, 140, 180, 220), 56, 0.3f};
+  const Detection person{cv::Rect2f(195, 145, 175, 210), 0, 0.8f};
+  RegionFusion other(c, classes);
+  EXPECT_EQ(other.fuse(FusionMode::kBoth, depth, {}, {}, {chair, person}).objects.size(), 2u);
+}
+
+}  // namespace
+}  // namespace dynamap

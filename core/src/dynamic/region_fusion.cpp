@@ -11,9 +11,10 @@ namespace dynamap {
 namespace {
 
 constexpr double kBinM = 0.1;
-constexpr int kStaticMinPoints = 5;  ///< points needed on an object to call it static now
-constexpr int kBins = 100;           // 0..10 m
-constexpr float kMatchIou = 0.3f;    ///< a detection continues a track above this IoU
+constexpr int kStaticMinPoints = 5;     ///< points needed on an object to call it static now
+constexpr int kBins = 100;              // 0..10 m
+constexpr float kMatchIou = 0.3f;       ///< a detection continues a track above this IoU
+constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelPerObject)
 
 /// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few. With `near_m` > 0
 /// only depths within kContinuityM of it compete (the object was there a frame ago).
@@ -178,13 +179,20 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   // fitted without it; one frame of clear motion removes it again.
   int before = prev != nullptr ? prev->quiet_frames : 0;
   if (prev != nullptr && prev->has_anchor) t.has_anchor = true, t.anchor_W = prev->anchor_W;
+  bool still = false;  // its world position stayed put (camera pose from proven landmarks)
   if (d.has_position && config_.static_max_drift_m > 0.0) {
     // Frame-to-frame checks cannot see a slow walker (a pixel a frame): its world position can.
     if (!t.has_anchor || cv::norm(d.p_W - t.anchor_W) > config_.static_max_drift_m) {
       t.has_anchor = true, t.anchor_W = d.p_W, before = 0;
+    } else {
+      still = true;
     }
   }
-  t.quiet_frames = d.moving_now ? 0 : before + (quiet && ev.background_fit ? 1 : 0);
+  // Static evidence of this frame: its points agree with the background's motion, or, when it
+  // has too few points to tell (a plain jacket, the depth-less border), its world position.
+  const bool few_points = d.points < kStaticMinPoints;
+  const bool evidence_now = (quiet && ev.background_fit) || (few_points && still);
+  t.quiet_frames = d.moving_now ? 0 : before + (evidence_now ? 1 : 0);
   if (d.moving_now) t.has_anchor = false;
   if (classes_.isHighDynamic(d.detection.class_id)) {
     t.moving = t.moving || t.quiet_frames < config_.static_confirm_frames;
@@ -243,11 +251,27 @@ void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& regi
   result.objects.push_back(d);
 }
 
+std::vector<Detection> RegionFusion::oneLabelPerObject(const std::vector<Detection>& in) const {
+  std::vector<Detection> out;
+  for (const auto& d : in) {
+    bool relabelled = false;
+    for (const auto& o : in) {
+      relabelled = relabelled ||
+                   (classes_.isHighDynamic(d.class_id) && !classes_.isHighDynamic(o.class_id) &&
+                    o.score > d.score && iou(d.box, o.box) >= kSameObjectIou);
+    }
+    if (!relabelled) out.push_back(d);
+  }
+  return out;
+}
+
 FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const std::vector<cv::Point2f>& points,
                                 const std::vector<std::uint8_t>& dyn,
-                                const std::vector<Detection>& detections,
+                                const std::vector<Detection>& all_detections,
                                 const FusionEvidence& evidence) {
+  // A teddy bear that is also a 0.3 "person" is one object: the better-scored class wins.
+  const std::vector<Detection> detections = oneLabelPerObject(all_detections);
   FusionResult result;
   proven_ = evidence.proven_static;
   evidence_ = &evidence;

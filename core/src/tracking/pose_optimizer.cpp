@@ -1,6 +1,7 @@
 #include "dynamap/core/tracking/pose_optimizer.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 
 #include <ceres/rotation.h>
@@ -11,6 +12,8 @@
 #include "dynamap/core/tracking/rgbd_residual.hpp"
 
 namespace dynamap {
+
+constexpr std::uint64_t kPnpSeed = 0x9e3779b97f4a7c15ULL;  ///< PnP RANSAC's sampling seed
 namespace {
 
 constexpr double kChi2Mono = 5.991;    // 95 %, 2 dof
@@ -81,10 +84,16 @@ bool PoseOptimizer::ransac(const std::vector<PoseCorrespondence>& corr, Eigen::I
   cv::Rodrigues(R, rvec);
   cv::eigen2cv(Eigen::Vector3d(T_C_W.translation()), tvec);
   std::vector<int> idx;
+  // solvePnPRansac draws from the thread's cv::theRNG(): seeded per call (and restored), a pose
+  // depends on its inputs only, not on what else ran on this thread before (two Systems
+  // interleaved on one thread give the same poses as each alone).
+  const cv::RNG saved = cv::theRNG();
+  cv::theRNG() = cv::RNG(kPnpSeed);
   const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, use_guess,
                                      iterations > 0 ? iterations : config_.pnp_ransac_iterations,
                                      static_cast<float>(config_.pnp_reprojection_px), 0.99, idx,
                                      use_guess ? cv::SOLVEPNP_ITERATIVE : cv::SOLVEPNP_AP3P);
+  cv::theRNG() = saved;
   if (!ok || static_cast<int>(idx.size()) < 4) return false;
   cv::Rodrigues(rvec, R);
   Eigen::Matrix3d Re;

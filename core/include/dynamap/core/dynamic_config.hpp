@@ -90,7 +90,7 @@ struct DynamicConfig {
   double static_max_dynamic_share = 0.25;
   /// ... and while its world position (centroid of its pixels, camera pose from landmarks proven
   /// static) stays within this of where the quiet run began (m; 0 = not checked).
-  double static_max_drift_m = 0.25;
+  double static_max_drift_m = 0.15;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode

@@ -86,6 +86,9 @@ class RegionFusion {
                     const FusionEvidence& evidence = FusionEvidence());
 
  private:
+  /// Drops a high-dynamic detection that overlaps (IoU >= 0.6) a better-scored detection of a
+  /// class that does not move by itself: the detector's two labels of one object.
+  std::vector<Detection> oneLabelPerObject(const std::vector<Detection>& in) const;
   /// Moves every track's box by the median flow of the points inside it.
   void propagateTracks(const std::vector<cv::Point2f>& points, const FusionEvidence& evidence);
   /// Decides `d` given its track in the last frame (null: new object); returns its new track.
