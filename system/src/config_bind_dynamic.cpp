@@ -11,7 +11,8 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.ransac_confidence", &c.ransac_confidence, 0.5, 0.999999);
   schema.addDouble("dynamic.homography_inlier_ratio", &c.homography_inlier_ratio, 0.0, 10.0);
 
-  schema.addString("dynamic.geometric_check", &c.geometric_check, {"rigid", "epipolar"});
+  schema.addString("dynamic.geometric_check", &c.geometric_check,
+                   {"pnp_reprojection", "rigid", "epipolar"});
   schema.addDouble("dynamic.reprojection_threshold_px", &c.reprojection_threshold_px, 0.01, 100.0);
   schema.addDouble("dynamic.rigid_epipolar_threshold_px", &c.rigid_epipolar_threshold_px, 0.01,
                    100.0);

@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
   app.add_option("--masked-fit-weight", config.masked_fit_weight, "dynamic.masked_fit_weight");
   app.add_option("--moving-ratio", config.moving_ratio, "dynamic.moving_ratio");
   app.add_option("--evidence-smoothing", config.evidence_smoothing, "dynamic.evidence_smoothing");
-  app.add_option("--geometric-check", config.geometric_check, "rigid | epipolar");
+  app.add_option("--geometric-check", config.geometric_check, "pnp_reprojection | epipolar");
   app.add_option("--detector", config.detector, "yolo_darknet | nanodet_onnx | ... | none");
   app.add_option("--model-cfg", config.model_cfg, "dynamic.model_cfg");
   app.add_option("--model-weights", config.model_weights, "dynamic.model_weights");

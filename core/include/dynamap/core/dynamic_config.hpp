@@ -25,9 +25,11 @@ struct DynamicConfig {
   /// Homography explains >= this share of the F inliers: low parallax / pure rotation; the
   /// homography transfer error is used instead of the ill-conditioned epipolar distance.
   double homography_inlier_ratio = 0.85;
-  /// rigid: PnP with the current depth (reprojection error; epipolar distance to the pose's F
-  /// for matches without depth); epipolar: fundamental matrix only (no depth).
-  std::string geometric_check = "rigid";
+  /// pnp_reprojection (default; "rigid" is its older name): the camera motion by PnP with the
+  /// current depth, each match's reprojection error against reprojection_threshold_px (3 px;
+  /// matches without depth: epipolar distance to that motion's F); epipolar: the paper's check,
+  /// RANSAC fundamental matrix and distance to the epipolar line (epipolar_threshold_px, 1 px).
+  std::string geometric_check = "pnp_reprojection";
   double reprojection_threshold_px = 3.0;  // scene residuals ~0.5 px; slow walkers ~4 px
   /// rigid check, matches without depth: symmetric epipolar distance to the PnP pose's F
   double rigid_epipolar_threshold_px = 2.5;
