@@ -34,6 +34,18 @@ for mode in off both; do run "teddy__$mode" "$TEDDY" --set dynamic.mode=$mode "$
 for mode in off geometry detector both; do
   run "teddy_dyn_dev__$mode" "$DYN" --set dynamic.mode=$mode "${TSDF[@]}"
 done
+# Crowded scenes (issue 15): the semi-synthetic crowd and the real Bonn crowd slice (its own
+# camera), removal off / on, and the paper's epipolar check beside the default PnP reprojection.
+CROWD=$DATA/dynamic/teddy_dyn_crowd_dev
+BONN=(--config config/bonn.yaml)
+for mode in off both; do run "teddy_dyn_crowd_dev__$mode" "$CROWD" --set dynamic.mode=$mode "${TSDF[@]}"; done
+run "teddy_dyn_crowd_dev__both-epipolar" "$CROWD" --set dynamic.geometric_check=epipolar "${TSDF[@]}"
+for mode in off detector both; do
+  run "rgbd_bonn_crowd_400_499__$mode" "$DATA/bonn/rgbd_bonn_crowd_400_499" "${BONN[@]}" \
+    --set dynamic.mode=$mode "${TSDF[@]}"
+done
+run "rgbd_bonn_crowd_400_499__both-epipolar" "$DATA/bonn/rgbd_bonn_crowd_400_499" "${BONN[@]}" \
+  --set dynamic.geometric_check=epipolar "${TSDF[@]}"
 # Real time: frames at their own timestamps, the newest frame wins.
 run "teddy_dyn_dev__realtime" "$DYN" --realtime "${TSDF[@]}"
 # Ablation of the mapping side's free-space check (README, Mapping backends).
@@ -44,6 +56,9 @@ run "teddy_dyn_dev__both-nofreespace" "$DYN" --set dynamic.mode=both "${TSDF[@]}
 for i in $(seq 2 "${REPEATS:-3}"); do
   for mode in off both; do run "teddy__${mode}_r$i" "$TEDDY" --set dynamic.mode=$mode "${TSDF[@]}"; done
   run "teddy_dyn_dev__both_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}"
+  for mode in off both; do
+    run "teddy_dyn_crowd_dev__${mode}_r$i" "$CROWD" --set dynamic.mode=$mode "${TSDF[@]}"
+  done
   run "teddy_dyn_dev__both-nofreespace_r$i" "$DYN" --set dynamic.mode=both "${TSDF[@]}" "${NOFS[@]}"
 done
 for backend in points pcl_voxel vdb_tsdf octomap; do

@@ -46,7 +46,7 @@ class DynamicMotionFilter::Worker {
       : detector_(std::move(detector)),
         threads_(threads),
         owner_(owner),
-        thread_([this] { loop(); }) {}
+        thread_((applyThreads(threads), [this] { loop(); })) {}
   ~Worker() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -89,8 +89,13 @@ class DynamicMotionFilter::Worker {
   }
 
  private:
+  /// OpenCV's pool size is set before the worker thread and any tracking start: set from the
+  /// worker itself, it changed under the tracker's first ORB/LK calls at a moment that depended
+  /// on thread timing, and a loaded machine then gave other keypoints (other trajectories).
+  static void applyThreads(int threads) {
+    if (threads > 0) cv::setNumThreads(threads);
+  }
   void loop() {
-    if (threads_ > 0) cv::setNumThreads(threads_);
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
       cv_.wait(lock, [&] { return stop_ || has_job_; });
