@@ -44,7 +44,6 @@ class DynamicMotionFilter::Worker {
 
   Worker(std::unique_ptr<ObjectDetector> detector, int threads, DynamicMotionFilter* owner)
       : detector_(std::move(detector)),
-        threads_(threads),
         owner_(owner),
         thread_((applyThreads(threads), [this] { loop(); })) {}
   ~Worker() {
@@ -125,7 +124,6 @@ class DynamicMotionFilter::Worker {
   }
 
   std::unique_ptr<ObjectDetector> detector_;
-  int threads_;
   DynamicMotionFilter* owner_;
   std::mutex mutex_;
   std::condition_variable cv_;
