@@ -34,7 +34,7 @@ run_asan() {
   cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_SANITIZE=ON >/dev/null
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_io_tests dynamap_eval_tests dynamap_tracking_tests dynamap_dynamic_tests \
-    dynamap_mapping_tests dynamap_cli_tests
+    dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests
   # detect_leaks: OpenCV/TBB/OpenVDB keep process-lifetime caches; leaks are checked too, with
   # the third-party ones listed in scripts/lsan.supp.
   # alloc_dealloc_mismatch=0: Debian's PCL is built as C++14, where Eigen gives PointCloud a
