@@ -237,3 +237,39 @@ TEST(SyntheticTracking, MovingBoxIsMaskedOutAndPoseStaysAccurate) {
 
 }  // namespace
 }  // namespace dynamap
+
+namespace dynamap {
+namespace {
+
+/// Frames after a long blank in a room the map has never seen (relocalization cannot work):
+/// how many of the last 10 are tracked.
+int trackedAfterLongLoss(int restart_after_lost_frames) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene first(camera, 12), other(camera, 99);
+  first.addDefaultRoom();
+  other.addDefaultRoom();
+  TrackerConfig config;
+  config.restart_after_lost_frames = restart_after_lost_frames;
+  Tracker tracker(camera, config, nullptr);
+  constexpr int kBlankFirst = 15, kBlankLast = 34, kEnd = 50;
+  int tracked = 0;
+  for (int i = 0; i < kEnd; ++i) {
+    auto r =
+        (i < kBlankFirst ? first : other).render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    if (i >= kBlankFirst && i <= kBlankLast) r.bgr.setTo(cv::Scalar::all(0));
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    tracked += i >= kEnd - 10 && res.status == FrameStatus::kTracked;
+  }
+  tracker.finish();
+  return tracked;
+}
+
+TEST(SyntheticTracking, ALongLossRestartsTheMapWhereTheCameraWasLastSeen) {
+  // 20 blank frames, then a room the map has never seen: without a restart the tracker stays
+  // lost for good; with one (after 15 lost frames) it tracks again.
+  EXPECT_EQ(trackedAfterLongLoss(0), 0);
+  EXPECT_EQ(trackedAfterLongLoss(15), 10);
+}
+
+}  // namespace
+}  // namespace dynamap

@@ -310,6 +310,7 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   evidence.flags_valid = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
   evidence.prev_points = m.prev_px;
   if (input.proven_static != nullptr) evidence.proven_static = *input.proven_static;
+  if (m.ids.size() == m.cur_px.size()) evidence.point_ids = m.ids;
   if (input.has_prior) {
     evidence.has_pose = true;
     const Eigen::Matrix4d T = input.T_W_C.matrix();

@@ -4,6 +4,49 @@
 
 namespace dynamap {
 
+AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
+                         const std::vector<PointSample>& now, const cv::Matx44d& T_W_C,
+                         const cv::Vec4d& K) {
+  AnchorCheck out;
+  const cv::Matx44d T_C_W = T_W_C.inv(cv::DECOMP_SVD);
+  std::vector<double> dist, dz;
+  for (const auto& s : now) {
+    if (s.depth_m <= 0.f) continue;
+    const double z = s.depth_m;
+    const cv::Vec4d p_C((s.px.x - K[2]) / K[0] * z, (s.px.y - K[3]) / K[1] * z, z, 1.0);
+    const cv::Vec4d p_W = T_W_C * p_C;
+    const PointAnchor here{s.id, cv::Vec3d(p_W[0], p_W[1], p_W[2])};
+    out.fresh.push_back(here);
+    const auto it =
+        std::lower_bound(anchors.begin(), anchors.end(), s.id,
+                         [](const PointAnchor& a, std::uint64_t id) { return a.id < id; });
+    if (it == anchors.end() || it->id != s.id) {
+      out.kept.push_back(here);
+      continue;
+    }
+    out.kept.push_back(*it);
+    const cv::Vec4d q = T_C_W * cv::Vec4d(it->p_W[0], it->p_W[1], it->p_W[2], 1.0);
+    if (q[2] <= 0.05) continue;
+    const cv::Point2f uv(static_cast<float>(K[0] * q[0] / q[2] + K[2]),
+                         static_cast<float>(K[1] * q[1] / q[2] + K[3]));
+    dist.push_back(cv::norm(uv - s.px));
+    dz.push_back(s.depth_m - q[2]);
+  }
+  const auto by_id = [](const PointAnchor& a, const PointAnchor& b) { return a.id < b.id; };
+  std::sort(out.kept.begin(), out.kept.end(), by_id);
+  std::sort(out.fresh.begin(), out.fresh.end(), by_id);
+  out.points = static_cast<int>(dist.size());
+  if (!dist.empty()) {
+    const auto mid = dist.begin() + static_cast<std::ptrdiff_t>(dist.size() / 2);
+    std::nth_element(dist.begin(), mid, dist.end());
+    out.median_px = *mid;
+    const auto mid_z = dz.begin() + static_cast<std::ptrdiff_t>(dz.size() / 2);
+    std::nth_element(dz.begin(), mid_z, dz.end());
+    out.median_dz_m = *mid_z;
+  }
+  return out;
+}
+
 bool medianFlowIn(const cv::Rect2f& box, const std::vector<cv::Point2f>& prev_px,
                   const std::vector<cv::Point2f>& cur_px, cv::Point2f* flow, int min_points) {
   std::vector<float> dx, dy;

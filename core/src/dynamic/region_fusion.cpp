@@ -12,6 +12,8 @@ namespace {
 
 constexpr double kBinM = 0.1;
 constexpr int kStaticMinPoints = 5;     ///< points needed on an object to call it static now
+constexpr int kAnchorMinPoints = 3;     ///< anchored points needed for the anchor test
+constexpr int kMaxSlowDoublings = 4;    ///< ObjectTrack::slow_moves: at most 16 x the frames
 constexpr int kBins = 100;              // 0..10 m
 constexpr float kMatchIou = 0.3f;       ///< a detection continues a track above this IoU
 constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelPerObject)
@@ -49,6 +51,24 @@ double depthMode(const cv::Mat& roi, double near_m) {
   }
   std::nth_element(vals.begin(), vals.begin() + vals.size() / 2, vals.end());
   return vals[vals.size() / 2];
+}
+
+/// Depth at `p` if no pixel kEdgePx away (4-neighbourhood) differs by more than kEdgeM or has
+/// no depth, else 0: a corner on an occlusion edge slides along it as the camera moves and is
+/// no fixed point of the object.
+constexpr int kEdgePx = 4;
+constexpr float kEdgeM = 0.1f;
+float interiorDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
+  const int x = cvRound(p.x), y = cvRound(p.y);
+  if (x < kEdgePx || y < kEdgePx || x >= depth_m.cols - kEdgePx || y >= depth_m.rows - kEdgePx)
+    return 0.f;
+  const float z = depth_m.at<float>(y, x);
+  for (const cv::Point o : {cv::Point(kEdgePx, 0), cv::Point(-kEdgePx, 0), cv::Point(0, kEdgePx),
+                            cv::Point(0, -kEdgePx)}) {
+    const float n = depth_m.at<float>(y + o.y, x + o.x);
+    if (n <= 0.f || std::abs(n - z) > kEdgeM) return 0.f;
+  }
+  return z;
 }
 
 bool inside(const cv::Mat& mask, const cv::Point2f& p) {
@@ -156,12 +176,28 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   const double evidence = observed ? d.weight * d.dynamic_points / d.points : 0.0;
   d.moving_now = observed && d.dynamic_points >= config_.min_dynamic_points &&
                  evidence >= config_.moving_ratio;
+  // Its own points followed over time, against the pose from landmarks proven static: within
+  // the pose noise (still), clearly off (moved: twice that), or in between (no verdict).
+  const double tau = config_.static_anchor_px;
+  const bool anchored = tau > 0.0 && d.anchor.points >= kAnchorMinPoints;
+  const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
+  const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;
+  const bool anchor_moved = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
+  // Flags that the anchors contradict were measured against a wrong camera motion.
+  const bool flagged_now = d.moving_now;
+  if (anchor_still) d.moving_now = false;
   const bool quiet = observed && d.points >= kStaticMinPoints &&
                      d.dynamic_points <= config_.static_max_dynamic_share * d.points;
   ObjectTrack t;
   t.box = d.detection.box;
   t.depth_m = d.depth_m > 0.0 || prev == nullptr ? d.depth_m : prev->depth_m;
   t.class_id = d.detection.class_id;
+  // A depth cut that jumped is another surface (the track went to another object): it starts
+  // with no slow moves.
+  const bool jumped = prev != nullptr && d.depth_m > 0.0 && prev->depth_m > 0.0 &&
+                      std::abs(d.depth_m - prev->depth_m) >= config_.depth_band_m;
+  t.slow_moves = (prev != nullptr && !jumped ? prev->slow_moves : 0) +
+                 (anchor_moved && !flagged_now && !jumped ? 1 : 0);
   const double a = config_.evidence_smoothing;
   t.score = evidence;
   if (prev != nullptr) t.score = observed ? a * prev->score + (1.0 - a) * evidence : prev->score;
@@ -180,7 +216,15 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   int before = prev != nullptr ? prev->quiet_frames : 0;
   if (prev != nullptr && prev->has_anchor) t.has_anchor = true, t.anchor_W = prev->anchor_W;
   bool still = false;  // its world position stayed put (camera pose from proven landmarks)
-  if (d.has_position && config_.static_max_drift_m > 0.0) {
+  t.anchors = d.anchor.kept;
+  if (anchored) {
+    // Its own points, followed over time, tell better than its centroid.
+    still = anchor_still;
+    if (anchor_moved) {
+      t.anchors = d.anchor.fresh, before = 0;
+      t.has_anchor = d.has_position, t.anchor_W = d.p_W;
+    }
+  } else if (d.has_position && config_.static_max_drift_m > 0.0) {
     // Frame-to-frame checks cannot see a slow walker (a pixel a frame): its world position can.
     if (!t.has_anchor || cv::norm(d.p_W - t.anchor_W) > config_.static_max_drift_m) {
       t.has_anchor = true, t.anchor_W = d.p_W, before = 0;
@@ -191,11 +235,14 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   // Static evidence of this frame: its points agree with the background's motion, or, when it
   // has too few points to tell (a plain jacket, the depth-less border), its world position.
   const bool few_points = d.points < kStaticMinPoints;
-  const bool evidence_now = (quiet && ev.background_fit) || (few_points && still);
+  const bool evidence_now =
+      anchored ? anchor_still : (quiet && ev.background_fit) || (few_points && still);
   t.quiet_frames = d.moving_now ? 0 : before + (evidence_now ? 1 : 0);
-  if (d.moving_now) t.has_anchor = false;
+  if (d.moving_now) t.has_anchor = false, t.anchors = d.anchor.fresh;
   if (classes_.isHighDynamic(d.detection.class_id)) {
-    t.moving = t.moving || t.quiet_frames < config_.static_confirm_frames;
+    // Anchors off by more than the pose noise mask it in this frame (its count is kept).
+    const int needed = config_.static_confirm_frames << std::min(t.slow_moves, kMaxSlowDoublings);
+    t.moving = t.moving || t.quiet_frames < needed || (anchored && !anchor_still);
   }
   d.moving = t.moving;
   d.quiet_frames = t.quiet_frames;
@@ -232,10 +279,20 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
       d.has_position = true;
     }
   }
+  const bool with_ids = evidence_->has_pose && evidence_->point_ids.size() == points.size();
+  std::vector<PointSample> samples;
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!inside(region, points[i])) continue;
     ++d.points;
     if (dyn[i]) ++d.dynamic_points;
+    if (with_ids) {
+      samples.push_back({evidence_->point_ids[i], points[i], interiorDepth(depth_m, points[i])});
+    }
+  }
+  if (with_ids) {
+    static const std::vector<PointAnchor> kNone;
+    d.anchor = checkAnchors(prev != nullptr ? prev->anchors : kNone, samples, evidence_->T_W_C,
+                            evidence_->K);
   }
   return region;
 }

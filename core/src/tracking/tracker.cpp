@@ -64,12 +64,14 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     result.status = FrameStatus::kLost;
     result.T_W_C = T_W_last_;
     tracks_.clear();
-    result.keyframe =
-        createKeyframe(frame, gray, Eigen::Isometry3d::Identity(), filtered.dynamic_mask);
+    // The first frame starts the map at the origin; a restart after a long loss starts a new
+    // part of the map where the camera was last seen.
+    result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered.dynamic_mask);
     if (result.keyframe) {
       initialized_ = true;
+      lost_streak_ = 0;
       result.status = FrameStatus::kTracked;
-      result.T_W_C = Eigen::Isometry3d::Identity();
+      result.T_W_C = T_W_last_;
       result.inliers = static_cast<int>(tracks_.size());
     }
   } else if (estimatePose(frame, T_W_C, result.inliers)) {
@@ -92,7 +94,11 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     result.T_W_C = T_W_last_;
     tracks_.clear();
     last_tracked_ = false;
+    // Lost for long (relocalization keeps failing, e.g. the map's texture is masked): restart.
+    const int restart = config_.restart_after_lost_frames;
+    if (initialized_ && restart > 0 && ++lost_streak_ >= restart) initialized_ = false;
   } else {
+    lost_streak_ = 0;
     velocity_ = last_tracked_ ? T_W_last_.inverse() * result.T_W_C : Eigen::Isometry3d::Identity();
     T_W_last_ = result.T_W_C;
     last_tracked_ = true;
@@ -174,6 +180,7 @@ void Tracker::Impl::matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d&
     kept.push_back(t);
     matches.prev_px.push_back(prev_px[i]);
     matches.cur_px.push_back(cur_px[i]);
+    matches.ids.push_back(t.landmark_id);
   }
   tracks_.swap(kept);
 }
@@ -183,6 +190,7 @@ void Tracker::Impl::matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d&
 void Tracker::Impl::trackProbes(const LkPyramid& cur, FeatureMatches& matches) {
   if (!filter_ || probes_.empty() || prev_pyramid_.empty()) {
     probes_.clear();
+    probe_ids_.clear();
     return;
   }
   cv::Point2f flow(0.f, 0.f);
@@ -202,14 +210,18 @@ void Tracker::Impl::trackProbes(const LkPyramid& cur, FeatureMatches& matches) {
   std::vector<std::uint8_t> ok;
   lk_.track(prev_pyramid_, cur, probes_, cur_px, ok);
   std::vector<cv::Point2f> kept;
+  std::vector<std::uint64_t> kept_ids;
   kept.reserve(probes_.size());
   for (std::size_t i = 0; i < probes_.size(); ++i) {
     if (!ok[i]) continue;
     matches.prev_px.push_back(probes_[i]);
     matches.cur_px.push_back(cur_px[i]);
+    matches.ids.push_back(probe_ids_[i]);
     kept.push_back(cur_px[i]);
+    kept_ids.push_back(probe_ids_[i]);
   }
   probes_.swap(kept);
+  probe_ids_.swap(kept_ids);
 }
 
 // Tops the probes up from the current frame (which is the next frame's previous one).
@@ -217,6 +229,7 @@ void Tracker::Impl::refillProbes(const cv::Mat& gray) {
   const int wanted = filter_ ? config_.motion_probes : 0;
   if (wanted <= 0) {
     probes_.clear();
+    probe_ids_.clear();
     return;
   }
   if (static_cast<int>(probes_.size()) >= wanted * 7 / 10) return;
@@ -228,6 +241,8 @@ void Tracker::Impl::refillProbes(const cv::Mat& gray) {
   cv::goodFeaturesToTrack(gray, fresh, wanted - static_cast<int>(probes_.size()), 0.01, spacing,
                           allowed);
   probes_.insert(probes_.end(), fresh.begin(), fresh.end());
+  for (std::size_t i = 0; i < fresh.size(); ++i)
+    probe_ids_.push_back(kProbeIdBit | next_probe_id_++);
 }
 
 MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const cv::Mat& gray,

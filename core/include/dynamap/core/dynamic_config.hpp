@@ -93,6 +93,14 @@ struct DynamicConfig {
   /// ... and while its world position (centroid of its pixels, camera pose from landmarks proven
   /// static) stays within this of where the quiet run began (m; 0 = not checked).
   double static_max_drift_m = 0.15;
+  /// ... and, where at least 3 of its tracked points were anchored in the world in earlier
+  /// frames, while their median reprojection distance stays within this (px; 0 = not checked).
+  /// This replaces the centroid test where it applies: a person swaying 5 cm on the spot moves
+  /// its points by several pixels, while its centroid wanders that much with occlusion alone.
+  double static_anchor_px = 3.0;
+  /// ... and their signed median depth difference within this (m): a sway along the line of
+  /// sight. Twice either threshold is motion: the count of quiet frames starts over.
+  double static_anchor_depth_m = 0.03;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode

@@ -15,7 +15,12 @@ namespace dynamap {
 struct FeatureMatches {
   std::vector<cv::Point2f> prev_px;
   std::vector<cv::Point2f> cur_px;
+  /// Per match (empty: unknown): an id that stays with the tracked point from frame to frame
+  /// (landmark ids for landmark tracks, kProbeIdBit | n for motion probes).
+  std::vector<std::uint64_t> ids;
 };
+
+constexpr std::uint64_t kProbeIdBit = std::uint64_t{1} << 63;
 
 /// What the tracker hands to the dynamic-point stage, between matching and pose estimation.
 struct MotionFilterInput {

@@ -82,6 +82,9 @@ struct TrackerConfig {
   int reloc_max_hamming = 64;  ///< ORB descriptor distance gate
   double reloc_ratio = 0.8;    ///< Lowe ratio test
   int reloc_min_inliers = 20;  ///< inliers needed to accept a relocalization
+  /// After this many frames lost in a row the map restarts where the camera was last seen
+  /// (0 = never: stay lost until relocalization succeeds).
+  int restart_after_lost_frames = 15;
 };
 
 }  // namespace dynamap

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -7,6 +8,40 @@
 #include "dynamap/core/dynamic/nms.hpp"
 
 namespace dynamap {
+
+/// Where a tracked point of an object was in the world when first seen on it.
+struct PointAnchor {
+  std::uint64_t id = 0;  ///< FeatureMatches::ids
+  cv::Vec3d p_W;
+};
+
+/// A tracked point of an object in the current frame: its id, pixel and depth (0 = none).
+struct PointSample {
+  std::uint64_t id = 0;
+  cv::Point2f px;
+  float depth_m = 0.f;
+};
+
+/// An object's points against where they were anchored: the median pixel distance between
+/// each anchored point's world position, projected with the current pose, and where the point
+/// is now, and the median depth difference there. A person standing still keeps it within the pose
+/// noise over many frames; a person swaying 5 cm on the spot, or walking slowly, drifts out of it
+/// while every frame-to-frame check passes.
+struct AnchorCheck {
+  int points = 0;          ///< anchored in an earlier frame and seen now (with depth)
+  double median_px = 0.0;  ///< their median distance
+  /// Signed median of (depth measured now - anchored point's depth in this camera): a person
+  /// swaying along the line of sight barely moves in the image but changes depth.
+  double median_dz_m = 0.0;
+  std::vector<PointAnchor> kept;   ///< earlier anchors seen now, plus the new points anchored
+  std::vector<PointAnchor> fresh;  ///< every point seen now, anchored where it is now
+};
+
+/// Checks `now` against `anchors` (sorted by id) with camera pose T_W_C (camera -> world) and
+/// intrinsics K = (fx, fy, cx, cy). Both outputs come back sorted by id.
+AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
+                         const std::vector<PointSample>& now, const cv::Matx44d& T_W_C,
+                         const cv::Vec4d& K);
 
 /// The temporal state of one detected object, carried from frame to frame by RegionFusion.
 struct ObjectTrack {
@@ -17,7 +52,11 @@ struct ObjectTrack {
   int missed = 0;        ///< frames since the detector last reported it
   double depth_m = 0.0;  ///< depth mode of its pixels when last seen (0 = unknown)
   bool has_anchor = false;
-  cv::Vec3d anchor_W;  ///< world position where its current run of quiet frames began
+  cv::Vec3d anchor_W;                ///< world position where its current run of quiet frames began
+  std::vector<PointAnchor> anchors;  ///< its points' world positions since that run began
+  /// Times its anchors showed motion that no frame-to-frame check saw (a sway, a slow step):
+  /// each doubles the quiet frames it needs to be kept (at most 16 x).
+  int slow_moves = 0;
   bool moving = false;
 };
 

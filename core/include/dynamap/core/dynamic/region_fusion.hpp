@@ -30,7 +30,8 @@ struct ObjectDecision {
   int quiet_frames = 0;     ///< observed frames with static evidence since it last moved
   double depth_m = 0.0;     ///< depth mode of the object (0 = no depth)
   bool has_position = false;
-  cv::Vec3d p_W;  ///< centroid of its pixels in the world (with FusionEvidence::has_pose)
+  cv::Vec3d p_W;       ///< centroid of its pixels in the world (with FusionEvidence::has_pose)
+  AnchorCheck anchor;  ///< its points against their world anchors (with point ids and a pose)
 };
 
 /// What, besides the point flags, fuse() may rely on in this frame.
@@ -47,6 +48,8 @@ struct FusionEvidence {
   /// carve static pixels out of a moving region: one frame's quiet flag is no proof when the
   /// camera motion was measured among movers.
   std::vector<std::uint8_t> proven_static;
+  /// Per point (empty: none): FeatureMatches::ids, to follow an object's points over time.
+  std::vector<std::uint64_t> point_ids;
   /// The camera pose (camera -> world) from landmarks proven static, and the intrinsics
   /// (fx, fy, cx, cy): an object's world position over time (has_pose false: not used).
   bool has_pose = false;

@@ -88,8 +88,11 @@ class Tracker::Impl {
   /// Per track this frame: a landmark seen by static_prior_min_keyframes keyframes that fits
   /// priorPose() (set by priorPose(), read by runMotionFilter()).
   std::vector<std::uint8_t> proven_static_;
-  std::vector<cv::Point2f> probes_;  ///< motion probes in the previous frame (not landmarks)
+  std::vector<cv::Point2f> probes_;       ///< motion probes in the previous frame (not landmarks)
+  std::vector<std::uint64_t> probe_ids_;  ///< one per probe, kProbeIdBit | a running number
+  std::uint64_t next_probe_id_ = 0;
   bool initialized_ = false;
+  int lost_streak_ = 0;  ///< frames lost in a row
   bool finished_ = false;
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step

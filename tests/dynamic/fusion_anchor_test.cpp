@@ -1,0 +1,98 @@
+// An object's tracked points anchored in the world: a still person keeps them where they were,
+// a person swaying on the spot (too slow for any frame-to-frame check) does not.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "dynamap/core/dynamic/region_fusion.hpp"
+
+namespace dynamap {
+namespace {
+
+const cv::Vec4d kK(535.4, 539.2, 320.1, 247.6);
+
+cv::Point2f project(const cv::Vec3d& p_C) {
+  return {static_cast<float>(kK[0] * p_C[0] / p_C[2] + kK[2]),
+          static_cast<float>(kK[1] * p_C[1] / p_C[2] + kK[3])};
+}
+
+cv::Matx44d translationX(double x) {
+  cv::Matx44d T = cv::Matx44d::eye();
+  T(0, 3) = x;
+  return T;
+}
+
+TEST(PointAnchors, StaticPointsStayPutMovedOnesShowInPixelsAndDepth) {
+  // Three points 2 m away, anchored from camera 1 (the world frame).
+  const std::vector<cv::Vec3d> world{{-0.2, 0.0, 2.0}, {0.0, 0.1, 2.0}, {0.2, -0.1, 2.1}};
+  std::vector<PointSample> first;
+  for (std::size_t i = 0; i < world.size(); ++i)
+    first.push_back({i, project(world[i]), static_cast<float>(world[i][2])});
+  const AnchorCheck a = checkAnchors({}, first, cv::Matx44d::eye(), kK);
+  EXPECT_EQ(a.points, 0);  // nothing was anchored before
+  ASSERT_EQ(a.kept.size(), 3u);
+  // Camera 2 moved 10 cm along x: static points reproject onto where they are seen.
+  const cv::Matx44d T_W_C2 = translationX(0.1);
+  const auto seen = [&](const cv::Vec3d& shift) {
+    std::vector<PointSample> s;
+    for (std::size_t i = 0; i < world.size(); ++i) {
+      const cv::Vec3d p_C = world[i] + shift - cv::Vec3d(0.1, 0.0, 0.0);
+      s.push_back({i, project(p_C), static_cast<float>(p_C[2])});
+    }
+    return checkAnchors(a.kept, s, T_W_C2, kK);
+  };
+  const AnchorCheck still = seen({0, 0, 0});
+  EXPECT_EQ(still.points, 3);
+  EXPECT_LT(still.median_px, 0.01);
+  EXPECT_LT(std::abs(still.median_dz_m), 1e-4);
+  // 5 cm sideways at 2 m: about 13 px.
+  EXPECT_NEAR(seen({0.05, 0, 0}).median_px, 535.4 * 0.05 / 2.0, 0.5);
+  // 5 cm away from the camera: a pixel or so, but 5 cm of depth.
+  const AnchorCheck deeper = seen({0, 0, 0.05});
+  EXPECT_LT(deeper.median_px, 2.0);
+  EXPECT_NEAR(deeper.median_dz_m, 0.05, 1e-3);
+}
+
+/// Share of `frames` frames in which a person at `z(i)` m is kept (not masked). The camera is
+/// still, the person's tracked points keep their ids and pixels and are never flagged: a
+/// frame-to-frame check sees nothing.
+template <typename DepthOf>
+double keptShare(const DynamicConfig& c, int frames, DepthOf z, bool with_ids) {
+  const cv::Rect person(280, 120, 90, 260);
+  std::vector<cv::Point2f> points;
+  for (int y = 5; y < 480; y += 10)
+    for (int x = 5; x < 640; x += 10) points.emplace_back(float(x), float(y));
+  const std::vector<std::uint8_t> quiet(points.size(), 0);
+  FusionEvidence ev;
+  ev.has_pose = true;
+  ev.K = kK;
+  if (with_ids)
+    for (std::size_t i = 0; i < points.size(); ++i) ev.point_ids.push_back(i);
+  RegionFusion fusion(c, ClassTable(c));
+  const Detection det{cv::Rect2f(270, 110, 110, 280), 0, 0.9f};
+  int kept = 0;
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat depth(480, 640, CV_32F, cv::Scalar(5.f));
+    depth(person).setTo(static_cast<float>(z(i)));
+    kept += !fusion.fuse(FusionMode::kBoth, depth, points, quiet, {det}, ev).objects.at(0).moving;
+  }
+  return kept / static_cast<double>(frames);
+}
+
+TEST(FusionAnchors, APersonSwayingAlongTheLineOfSightIsRarelyKeptAStillOneIs) {
+  // teddy_dyn_crowd_dev's swayer: 7 cm amplitude, 2.5 s period (75 frames), 2.5 m away,
+  // swaying towards the camera; three periods.
+  const auto sway = [](int i) { return 2.5 + 0.07 * std::sin(2.0 * CV_PI * i / 75.0); };
+  const auto stand = [](int) { return 2.5; };
+  DynamicConfig c;
+  const double swayer = keptShare(c, 225, sway, true);
+  // Its centroid stays within static_max_drift_m: without point ids it is kept most of the time.
+  const double swayer_no_ids = keptShare(c, 225, sway, false);
+  EXPECT_GT(swayer_no_ids, 0.8);
+  EXPECT_LT(swayer, 0.2) << "no ids: " << swayer_no_ids;
+  // Kept from static_confirm_frames on (5 of 225 frames masked).
+  EXPECT_GT(keptShare(c, 225, stand, true), 0.95);
+}
+
+}  // namespace
+}  // namespace dynamap
