@@ -31,6 +31,18 @@ inline BackendCase backendCase(const std::string& name) {
   return it == cases.end() ? BackendCase{} : it->second;
 }
 
+/// Keyframe `k` (10 Hz stamps) of a rendered synthetic frame, with its mask if `with_mask`.
+inline KeyframePacketPtr syntheticKeyframe(const SyntheticFrame& f, int k, bool with_mask) {
+  auto kf = std::make_shared<KeyframePacket>();
+  kf->id = static_cast<std::uint64_t>(k);
+  kf->timestamp_s = 0.1 * k;
+  kf->T_W_C = f.T_W_C;
+  kf->bgr = f.bgr;
+  kf->depth_m = f.depth_m;
+  if (with_mask) kf->dynamic_mask = f.mask;
+  return kf;
+}
+
 /// Feeds `n` synthetic frames (with masks unless !with_mask) through a MappingWorker, optionally
 /// moves every keyframe by `shift` through pose updates, finishes and exports into `dir`.
 inline MapStats buildSyntheticMap(std::unique_ptr<MapBackend> backend, int n, bool with_mask,
@@ -41,16 +53,9 @@ inline MapStats buildSyntheticMap(std::unique_ptr<MapBackend> backend, int n, bo
   MappingWorker worker(std::move(backend), SyntheticScene::camera(), options, 2, &timings);
   std::vector<PoseUpdate> updates;
   for (int k = 0; k < n; ++k) {
-    SyntheticFrame f = scene.render(k, n);
-    auto kf = std::make_shared<KeyframePacket>();
-    kf->id = static_cast<std::uint64_t>(k);
-    kf->timestamp_s = 0.1 * k;
-    kf->T_W_C = f.T_W_C;
-    kf->bgr = f.bgr;
-    kf->depth_m = f.depth_m;
-    if (with_mask) kf->dynamic_mask = f.mask;
+    auto kf = syntheticKeyframe(scene.render(k, n), k, with_mask);
     worker.push(kf);
-    updates.push_back({kf->id, Eigen::Translation3d(shift) * f.T_W_C});
+    updates.push_back({kf->id, Eigen::Translation3d(shift) * kf->T_W_C});
   }
   if (!shift.isZero()) worker.applyPoseUpdates(updates);
   worker.finish();

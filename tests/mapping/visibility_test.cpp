@@ -34,15 +34,7 @@ std::vector<Eigen::Vector3f> buildMap(const std::string& backend,
   MappingWorker worker(registry.create(backend, backendCase(backend).params),
                        SyntheticScene::camera(), options, 2, &timings);
   for (int k = 0; k < kFrames; ++k) {
-    const SyntheticFrame f = scene.render(k, kFrames, boxAt(k));
-    auto kf = std::make_shared<KeyframePacket>();
-    kf->id = static_cast<std::uint64_t>(k);
-    kf->timestamp_s = 0.1 * k;
-    kf->T_W_C = f.T_W_C;
-    kf->bgr = f.bgr;
-    kf->depth_m = f.depth_m;
-    if (all_masks || masked(k)) kf->dynamic_mask = f.mask;
-    worker.push(kf);
+    worker.push(syntheticKeyframe(scene.render(k, kFrames, boxAt(k)), k, all_masks || masked(k)));
   }
   worker.finish();
   const fs::path dir = freshTempDir("visibility_" + backend + "_" + name);
