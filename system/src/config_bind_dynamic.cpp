@@ -52,6 +52,10 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.static_max_drift_m", &c.static_max_drift_m, 0.0, 100.0);
   schema.addDouble("dynamic.static_anchor_px", &c.static_anchor_px, 0.0, 1000.0);
   schema.addDouble("dynamic.static_anchor_depth_m", &c.static_anchor_depth_m, 0.001, 10.0);
+  schema.addInt("dynamic.dense_check_frames", &c.dense_check_frames, 0, 120);
+  schema.addInt("dynamic.dense_min_region_px", &c.dense_min_region_px, 1, 1000000);
+  schema.addDouble("dynamic.dense_depth_range_m", &c.dense_depth_range_m, 0.001, 10.0);
+  schema.addDouble("dynamic.dense_grow_m", &c.dense_grow_m, 0.0, 10.0);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);

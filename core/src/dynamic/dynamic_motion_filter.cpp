@@ -9,6 +9,7 @@
 #include <thread>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace dynamap {
 
@@ -161,7 +162,8 @@ DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config, const Pinh
       mode_(parseMode(config.mode)),
       classes_(config),
       fusion_(config, classes_),
-      timing_(timing) {
+      timing_(timing),
+      depth_history_(2 * config.dense_check_frames) {
   if (mode_ != FusionMode::kGeometry && config.detector != "none") {
     worker_ = std::make_unique<Worker>(makeObjectDetector(detectorOptions(config), classes_),
                                        config.detector_threads, this);
@@ -274,6 +276,34 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
   return r;
 }
 
+void DynamicMotionFilter::keepLastDepth(const MotionFilterInput& input) {
+  if (pending_.frame != filtered_ - 1) return;
+  // The last frame's final pose: X_W = T_W_C T_prev_cur^-1 X_prev.
+  const Eigen::Matrix4d T_last = (input.T_W_C * input.T_prev_cur.inverse()).matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) pending_.T_W_C(r, c) = T_last(r, c);
+  depth_history_.push(std::move(pending_));
+}
+
+void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence,
+                                         FusionResult& fused) {
+  const DepthView* view = depth_history_.newestUpTo(filtered_ - config_.dense_check_frames);
+  if (view == nullptr || depth_m.empty()) return;
+  SeenThroughOptions o;
+  o.min_region_px = config_.dense_min_region_px;
+  o.depth_range_m = config_.dense_depth_range_m;
+  o.grow_m = config_.dense_grow_m;
+  // Objects already decided (moving or kept) are fusion's: a kept person is not re-judged here.
+  cv::Mat moved = seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
+                                     fused.mask | fused.static_objects, o, &fused.seen_through);
+  if (fused.seen_through == 0) return;
+  if (config_.mask_dilation_px > 0) {
+    const int k = 2 * config_.mask_dilation_px + 1;
+    cv::dilate(moved, moved, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  }
+  fused.mask |= moved;
+}
+
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   static const FeatureMatches kNoMatches;
   const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
@@ -317,8 +347,14 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c) evidence.T_W_C(r, c) = T(r, c);
     evidence.K = K_;
+    keepLastDepth(input);
   }
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
+  record("fusion", msSince(start));
+  start = Clock::now();
+  if (evidence.has_pose && mode_ != FusionMode::kDetector)
+    addSeenThrough(frame_depth, evidence, fused);
+  record("dense_check", msSince(start));
   MotionFilterOutput out;
   out.match_is_dynamic.resize(m.cur_px.size(), 0);
   for (std::size_t i = 0; i < m.cur_px.size(); ++i) {
@@ -329,7 +365,9 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   }
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
   prev_mask_ = fused.mask;
-  record("fusion", msSince(start));
+  pending_ = DepthView();
+  if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(frame_depth, filtered_);
+  ++filtered_;
 
   diagnostics_.matches = m;
   diagnostics_.epipolar_dynamic = epi.is_dynamic;
@@ -339,6 +377,7 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   diagnostics_.detections = std::move(dets);
   diagnostics_.objects = std::move(fused.objects);
   diagnostics_.clusters = fused.clusters;
+  diagnostics_.seen_through = fused.seen_through;
   diagnostics_.mask = fused.mask;
   return out;
 }

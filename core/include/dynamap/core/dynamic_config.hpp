@@ -101,6 +101,16 @@ struct DynamicConfig {
   /// ... and their signed median depth difference within this (m): a sway along the line of
   /// sight. Twice either threshold is motion: the count of quiet frames starts over.
   double static_anchor_depth_m = 0.03;
+  /// Dense check without a detector: the depth of the frame this many frames back (0 = off),
+  /// seen from the current pose, against the current depth. Pixels it saw through (beyond
+  /// the sensor noise), outside the detected objects, in groups of at least dense_min_region_px,
+  /// are grown into their surface (pixels within dense_depth_range_m of their depth, inside
+  /// their box grown by dense_grow_m on each side) and masked: a pushed box, an arm, a person
+  /// before the detector finds them.
+  int dense_check_frames = 6;
+  int dense_min_region_px = 800;
+  double dense_depth_range_m = 0.15;
+  double dense_grow_m = 0.5;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "dynamap/core/camera.hpp"
+#include "dynamap/core/dynamic/depth_check.hpp"
 #include "dynamap/core/dynamic/epipolar_check.hpp"
 #include "dynamap/core/dynamic/object_detector.hpp"
 #include "dynamap/core/dynamic/region_fusion.hpp"
@@ -26,12 +27,13 @@ struct MotionDiagnostics {
   std::vector<Detection> detections;  ///< detector output after NMS
   std::vector<ObjectDecision> objects;
   int clusters = 0;
+  int seen_through = 0;  ///< regions added by the dense check
   cv::Mat mask;
 };
 
 /// Motion-area removal: epipolar check + (optional) detector on a worker thread + fusion.
 /// Per-stage durations go to "detector" (on the worker, one entry per detection), "epipolar",
-/// "fusion" and "detector_wait" (how long filter() blocked on the detector). With
+/// "fusion", "dense_check" and "detector_wait" (how long filter() blocked on the detector). With
 /// detector_async (default) beginFrame() only hands a frame over when the detector is idle
 /// ("detector_skipped" counts the others), filter() uses the newest finished detections
 /// ("detector_fresh" counts frames where a new result arrived, "detector_age" records the age
@@ -63,6 +65,12 @@ class DynamicMotionFilter : public MotionFilter {
   /// Moves the worker's newest finished detections (with `wait`, of the frame in flight) into
   /// latest_, if there are any.
   void takeDetections(bool wait);
+  /// Moves the last frame's depth (pending_) into the history with its final pose, which this
+  /// frame's input brings (input.has_prior).
+  void keepLastDepth(const MotionFilterInput& input);
+  /// The dense check (DynamicConfig::dense_check_frames): what the frame that many frames back
+  /// saw through, outside fusion's objects, is added to the mask.
+  void addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence, FusionResult& fused);
   /// *background_fit: the camera motion was fitted on enough matches outside people and masks.
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets, const RigidMotion* prior,
@@ -87,6 +95,11 @@ class DynamicMotionFilter : public MotionFilter {
   MotionDiagnostics diagnostics_;
   RigidMotion motion_;  ///< last frame-to-frame camera motion (diagnostics)
   cv::Mat prev_mask_;   ///< last frame's mask: its matches do not vote for the camera motion
+  /// Recent frames with their final poses (DynamicConfig::dense_check_frames). The last frame
+  /// waits in pending_ until the next filter() call brings its final pose.
+  DepthHistory depth_history_;
+  DepthView pending_;
+  long filtered_ = 0;  ///< filter() calls so far
 };
 
 /// nullptr for mode "off"; modes geometry | detector | both. Throws like the constructor.

@@ -61,7 +61,8 @@ struct FusionResult {
   cv::Mat mask;            ///< CV_8UC1, 255 = moving
   cv::Mat static_objects;  ///< CV_8UC1, 255 = pixels of detected objects decided not moving
   std::vector<ObjectDecision> objects;
-  int clusters = 0;  ///< dynamic-point clusters grown into regions outside objects
+  int clusters = 0;      ///< dynamic-point clusters grown into regions outside objects
+  int seen_through = 0;  ///< regions the dense check added (DynamicMotionFilter)
 };
 
 /// The object's own pixels inside `box`: pixels within `band_m` of the dominant depth mode of

@@ -1,0 +1,100 @@
+#pragma once
+
+#include <deque>
+
+#include <opencv2/core.hpp>
+
+namespace dynamap {
+
+/// A past depth frame and the camera pose (camera -> world) it was taken from.
+struct DepthView {
+  cv::Mat depth_m;  ///< CV_32FC1, 0 = no measurement
+  cv::Matx44d T_W_C = cv::Matx44d::eye();
+  long frame = -1;     ///< frame number it belongs to
+  double scale = 1.0;  ///< its pixels per pixel of the full image (intrinsics scale with it)
+};
+
+/// How the pixels of a region agree with what an earlier view saw along the same rays. Each
+/// sampled pixel's 3-D point is projected into the view and compared with the view's depth
+/// around that pixel (a few pixels of slack for the pose and the edges):
+/// consistent: the view saw a surface there within the noise margin (a still surface);
+/// seen_through: the view saw beyond the point everywhere around (the point was not there then:
+/// something moved in); nearer: the view saw a surface up to near_band_m in front of it (most
+/// likely this object, nearer to the camera then: it moves away); occluded: the view saw
+/// something farther in front (another object in the way).
+struct DepthAgreement {
+  int samples = 0;  ///< sampled pixels whose point lies in the view and has depth there
+  int consistent = 0;
+  int seen_through = 0;
+  int nearer = 0;
+  int occluded = 0;
+  double share(int n) const { return samples > 0 ? static_cast<double>(n) / samples : 0.0; }
+};
+
+struct DepthCheckOptions {
+  int stride_px = 4;            ///< every stride-th pixel in x and y is sampled
+  int slack_px = 2;             ///< the view's depth is read in a (2 slack + 1)^2 window
+  double noise_sigmas = 3.0;    ///< margin in standard deviations of the difference of 2 depths
+  double pose_margin_m = 0.01;  ///< added to the margin for the pose error
+  /// ... and this share of the depth, for the sensor's low-frequency depth distortion (a few
+  /// centimetres at 3 m towards the image borders on a Kinect).
+  double relative_margin = 0.02;
+  int border_px = 16;        ///< pixels this close to the image border are not sampled
+  double near_band_m = 0.4;  ///< DepthAgreement::nearer: at most this in front
+};
+
+/// One standard deviation (m) of a structured-light depth sensor at depth z (m):
+/// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi, Lovell 2012, for the Kinect).
+double depthNoiseM(double z_m);
+
+/// Compares the sampled pixels of `region` (CV_8UC1, 255 = in; only inside `roi`) of the current
+/// depth (pose T_W_C, intrinsics K = fx, fy, cx, cy) with `view`. Pixels on depth edges (a
+/// neighbour 4 px away differs by more than 0.1 m) are not sampled. With `seen_through` (a
+/// CV_8UC1 image of the depth's size) each seen-through sample sets its stride x stride cell.
+DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi,
+                               const cv::Matx44d& T_W_C, const cv::Vec4d& K, const DepthView& view,
+                               const DepthCheckOptions& options, cv::Mat* seen_through = nullptr);
+
+struct SeenThroughOptions {
+  DepthCheckOptions check;
+  int min_region_px = 800;  ///< smaller groups of seen-through pixels are noise
+  /// Growth into the whole surface: connected pixels within this of a seed's depth (a fixed
+  /// range, not a step: the floor a box stands on joins it smoothly, but leaves the range
+  /// within a few rows).
+  double depth_range_m = 0.15;
+  /// Growth stays inside the group's box grown by this much (m, at the group's depth) on each
+  /// side: a seen-through strip is often just the leading edge of what moved.
+  double grow_m = 0.5;
+};
+
+/// The dense geometric check, which needs no detector: the pixels of the current depth (pose
+/// T_W_C) that `view` saw through (it saw a surface behind them, beyond the noise margin: they
+/// were not there then), outside `exclude` (CV_8UC1, 255 = already decided; may be empty),
+/// in groups of at least min_region_px, each grown into the surface it belongs to (never into
+/// `exclude`). A surface that only appeared from behind something (the
+/// camera moved) is not seen through: `view` saw the occluder in front of it. CV_8UC1, 255 =
+/// moved; *regions = the number of groups kept.
+cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
+                           const DepthView& view, const cv::Mat& exclude,
+                           const SeenThroughOptions& options, int* regions = nullptr);
+
+/// The depth of the last frames with their poses, kept at half resolution, to compare the
+/// current frame with an earlier one. Not thread-safe (one caller).
+class DepthHistory {
+ public:
+  /// Keeps frames up to `max_age` frames older than the newest (0: none).
+  explicit DepthHistory(int max_age) : max_age_(max_age) {}
+  /// A half-resolution copy of `depth_m` as a view (pose to be set before push()).
+  static DepthView halfView(const cv::Mat& depth_m, long frame);
+  /// Adds a view (newer than every kept one).
+  void push(DepthView view);
+  /// The newest kept view taken no later than `last_frame`; null if there is none.
+  const DepthView* newestUpTo(long last_frame) const;
+  void clear() { views_.clear(); }
+
+ private:
+  int max_age_;
+  std::deque<DepthView> views_;  ///< oldest first
+};
+
+}  // namespace dynamap

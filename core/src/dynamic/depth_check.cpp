@@ -1,0 +1,182 @@
+#include "dynamap/core/dynamic/depth_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace dynamap {
+
+namespace {
+
+constexpr int kEdgePx = 4;
+constexpr float kEdgeM = 0.1f;
+
+/// Depth at (x, y) unless a 4-neighbour kEdgePx away has none or differs by more than kEdgeM.
+float interior(const cv::Mat& depth_m, int x, int y) {
+  const float z = depth_m.at<float>(y, x);
+  if (z <= 0.f) return 0.f;
+  const int xs[4] = {x - kEdgePx, x + kEdgePx, x, x};
+  const int ys[4] = {y, y, y - kEdgePx, y + kEdgePx};
+  for (int k = 0; k < 4; ++k) {
+    if (xs[k] < 0 || ys[k] < 0 || xs[k] >= depth_m.cols || ys[k] >= depth_m.rows) return 0.f;
+    const float n = depth_m.at<float>(ys[k], xs[k]);
+    if (n <= 0.f || std::abs(n - z) > kEdgeM) return 0.f;
+  }
+  return z;
+}
+
+enum class Verdict { kNone, kConsistent, kSeenThrough, kNearer, kOccluded };
+
+/// The view's depth in a window around (u, v) against the point's depth z there.
+Verdict judge(const cv::Mat& view_depth, int u, int v, int slack, float z, float margin,
+              float band) {
+  float nearest = 0.f;
+  bool any = false, consistent = false;
+  for (int y = std::max(0, v - slack); y <= std::min(view_depth.rows - 1, v + slack); ++y) {
+    const float* row = view_depth.ptr<float>(y);
+    for (int x = std::max(0, u - slack); x <= std::min(view_depth.cols - 1, u + slack); ++x) {
+      const float d = row[x];
+      if (d <= 0.f) continue;
+      consistent = consistent || std::abs(d - z) <= margin;
+      nearest = any ? std::min(nearest, d) : d;
+      any = true;
+    }
+  }
+  if (!any) return Verdict::kNone;
+  if (consistent) return Verdict::kConsistent;
+  if (nearest > z + margin) return Verdict::kSeenThrough;
+  return nearest >= z - band ? Verdict::kNearer : Verdict::kOccluded;
+}
+
+/// Median depth of the sampled pixels of group `label` (0 if none has depth).
+double groupDepth(const cv::Mat& depth_m, const cv::Mat& labels, int label, const cv::Rect& box,
+                  int step) {
+  std::vector<float> z;
+  for (int y = box.y + step / 2; y < box.y + box.height; y += step) {
+    for (int x = box.x + step / 2; x < box.x + box.width; x += step) {
+      if (labels.at<int>(y, x) == label && depth_m.at<float>(y, x) > 0.f) {
+        z.push_back(depth_m.at<float>(y, x));
+      }
+    }
+  }
+  if (z.empty()) return 0.0;
+  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
+  return z[z.size() / 2];
+}
+
+}  // namespace
+
+double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
+
+DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi,
+                               const cv::Matx44d& T_W_C, const cv::Vec4d& K, const DepthView& view,
+                               const DepthCheckOptions& o, cv::Mat* seen_through) {
+  DepthAgreement out;
+  if (view.depth_m.empty() || depth_m.empty()) return out;
+  const cv::Matx44d T_V_C = view.T_W_C.inv(cv::DECOMP_SVD) * T_W_C;
+  const double sv = view.scale;
+  const int slack = std::max(1, cvRound(o.slack_px * sv));
+  const int b = std::max(0, o.border_px);
+  const cv::Rect r = roi & cv::Rect(b, b, depth_m.cols - 2 * b, depth_m.rows - 2 * b);
+  const int step = std::max(1, o.stride_px);
+  const double k_sigma = o.noise_sigmas * std::sqrt(2.0);
+  for (int y = r.y + step / 2; y < r.y + r.height; y += step) {
+    for (int x = r.x + step / 2; x < r.x + r.width; x += step) {
+      if (!region.empty() && region.at<uchar>(y, x) == 0) continue;
+      const float z = interior(depth_m, x, y);
+      if (z <= 0.f) continue;
+      const cv::Vec4d p_C((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z, 1.0);
+      const cv::Vec4d p_V = T_V_C * p_C;
+      if (p_V[2] <= 0.1) continue;
+      const int u = cvRound(sv * (K[0] * p_V[0] / p_V[2] + K[2] + 0.5) - 0.5);
+      const int v = cvRound(sv * (K[1] * p_V[1] / p_V[2] + K[3] + 0.5) - 0.5);
+      if (u < 0 || v < 0 || u >= view.depth_m.cols || v >= view.depth_m.rows) continue;
+      const double zv = p_V[2];
+      const auto margin =
+          static_cast<float>(k_sigma * depthNoiseM(zv) + o.pose_margin_m + o.relative_margin * zv);
+      const Verdict verdict = judge(view.depth_m, u, v, slack, static_cast<float>(zv), margin,
+                                    static_cast<float>(o.near_band_m));
+      if (verdict == Verdict::kNone) continue;
+      ++out.samples;
+      if (verdict == Verdict::kConsistent) ++out.consistent;
+      if (verdict == Verdict::kNearer) ++out.nearer;
+      if (verdict == Verdict::kOccluded) ++out.occluded;
+      if (verdict == Verdict::kSeenThrough) {
+        ++out.seen_through;
+        if (seen_through != nullptr) {
+          const cv::Rect cell(x - step / 2, y - step / 2, step, step);
+          (*seen_through)(cell & cv::Rect(0, 0, depth_m.cols, depth_m.rows)).setTo(255);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+DepthView DepthHistory::halfView(const cv::Mat& depth_m, long frame) {
+  DepthView view;
+  view.frame = frame;
+  view.scale = 0.5;
+  // Nearest (not averaged) samples: a mean across an occlusion edge is a depth nobody saw.
+  if (!depth_m.empty()) cv::resize(depth_m, view.depth_m, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+  return view;
+}
+
+void DepthHistory::push(DepthView view) {
+  if (max_age_ <= 0 || view.depth_m.empty()) return;
+  const long frame = view.frame;
+  views_.push_back(std::move(view));
+  while (!views_.empty() && views_.front().frame < frame - max_age_) views_.pop_front();
+}
+
+const DepthView* DepthHistory::newestUpTo(long last_frame) const {
+  for (auto it = views_.rbegin(); it != views_.rend(); ++it) {
+    if (it->frame <= last_frame) return &*it;
+  }
+  return nullptr;
+}
+
+cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
+                           const DepthView& view, const cv::Mat& exclude,
+                           const SeenThroughOptions& o, int* regions) {
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  if (regions != nullptr) *regions = 0;
+  cv::Mat seen = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  compareWithView(depth_m, cv::Mat(), cv::Rect(0, 0, depth_m.cols, depth_m.rows), T_W_C, K, view,
+                  o.check, &seen);
+  if (!exclude.empty()) seen.setTo(0, exclude);
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(seen, labels, stats, centroids, 8, CV_32S);
+  const cv::Rect image(0, 0, depth_m.cols, depth_m.rows);
+  const int step = std::max(1, o.check.stride_px);
+  for (int c = 1; c < n; ++c) {
+    if (stats.at<int>(c, cv::CC_STAT_AREA) < o.min_region_px) continue;
+    const cv::Rect tight(stats.at<int>(c, cv::CC_STAT_LEFT), stats.at<int>(c, cv::CC_STAT_TOP),
+                         stats.at<int>(c, cv::CC_STAT_WIDTH), stats.at<int>(c, cv::CC_STAT_HEIGHT));
+    const double z = groupDepth(depth_m, labels, c, tight, step);
+    if (z <= 0.0) continue;
+    const int gw = cvRound(o.grow_m * K[0] / z), gh = cvRound(o.grow_m * K[1] / z);
+    const cv::Rect roi =
+        cv::Rect(tight.x - gw, tight.y - gh, tight.width + 2 * gw, tight.height + 2 * gh) & image;
+    cv::Mat flood = cv::Mat::zeros(roi.height + 2, roi.width + 2, CV_8UC1);
+    if (!exclude.empty()) flood(cv::Rect(1, 1, roi.width, roi.height)).setTo(1, exclude(roi));
+    const cv::Mat depth_roi = depth_m(roi).clone();
+    const cv::Scalar tol(o.depth_range_m);
+    for (int y = tight.y + step / 2; y < tight.y + tight.height; y += step) {
+      for (int x = tight.x + step / 2; x < tight.x + tight.width; x += step) {
+        if (labels.at<int>(y, x) != c) continue;
+        const cv::Point p(x - roi.x, y - roi.y);
+        if (depth_roi.at<float>(p) <= 0.f || flood.at<uchar>(p.y + 1, p.x + 1) != 0) continue;
+        cv::floodFill(depth_roi, flood, p, cv::Scalar(), nullptr, tol, tol,
+                      8 | cv::FLOODFILL_FIXED_RANGE | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+      }
+    }
+    out(roi).setTo(255, flood(cv::Rect(1, 1, roi.width, roi.height)) == 255);
+    if (regions != nullptr) ++*regions;
+  }
+  return out;
+}
+
+}  // namespace dynamap

@@ -1,0 +1,135 @@
+// The dense geometric check (depth_check.hpp) on synthetic scenes with known geometry: a still
+// room seen from two poses, and a textured box pushed across the floor that no detector knows.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "dynamap/core/dynamic/depth_check.hpp"
+#include "synthetic_scene.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr double kFramePeriodS = 1.0 / 30.0;
+
+cv::Matx44d toMatx(const Eigen::Isometry3d& T) {
+  cv::Matx44d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = T.matrix()(r, c);
+  return m;
+}
+
+/// A hand-held camera drifting sideways and turning a little (about 2 cm and 0.4 deg a frame).
+Eigen::Isometry3d cameraAt(int frame) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(0.02 * frame, -0.005 * frame, 0.01 * frame);
+  T.linear() = Eigen::AngleAxisd(0.007 * frame, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  return T;
+}
+
+cv::Vec4d intrinsics(const PinholeCamera& c) { return {c.fx, c.fy, c.cx, c.cy}; }
+
+DepthView viewOf(const test::RenderedFrame& f, const Eigen::Isometry3d& T_W_C, long frame) {
+  DepthView v = DepthHistory::halfView(f.depth_m, frame);
+  v.T_W_C = toMatx(T_W_C);
+  return v;
+}
+
+struct PushedBox {
+  PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene{camera, 21};
+  PushedBox() {
+    scene.addDefaultRoom();
+    // 60 cm box on the floor (y = 1.3 is the floor, y down), pushed at 0.6 m/s along x.
+    scene.addMovingBox({0.0, 1.0, 3.0}, {0.3, 0.3, 0.3}, {0.6, 0.0, 0.0});
+  }
+  test::RenderedFrame at(int frame) const {
+    return scene.render(cameraAt(frame), frame * kFramePeriodS);
+  }
+};
+
+TEST(DepthCheck, SensorNoiseGrowsWithTheSquareOfDepth) {
+  EXPECT_NEAR(depthNoiseM(0.4), 0.0012, 1e-9);
+  EXPECT_NEAR(depthNoiseM(3.4), 0.0012 + 0.0019 * 9.0, 1e-9);
+}
+
+TEST(DepthCheck, AStillRoomAgreesWithAnEarlierViewAndNothingIsSeenThrough) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 7);
+  scene.addDefaultRoom();
+  const auto before = scene.render(cameraAt(0), 0.0);
+  const auto now = scene.render(cameraAt(6), 6 * kFramePeriodS);
+  const DepthView view = viewOf(before, cameraAt(0), 0);
+  const cv::Rect all(0, 0, camera.width, camera.height);
+  const DepthAgreement a = compareWithView(now.depth_m, cv::Mat(), all, toMatx(cameraAt(6)),
+                                           intrinsics(camera), view, DepthCheckOptions());
+  ASSERT_GT(a.samples, 10000);
+  // 12 cm and 2.4 deg apart: what both saw agrees; what only one saw is behind an occluder.
+  EXPECT_GT(a.share(a.consistent), 0.97);
+  EXPECT_LT(a.share(a.seen_through), 0.001);
+  int regions = -1;
+  const cv::Mat moved = seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), intrinsics(camera),
+                                           view, cv::Mat(), SeenThroughOptions(), &regions);
+  EXPECT_EQ(regions, 0);
+  EXPECT_EQ(cv::countNonZero(moved), 0);
+}
+
+TEST(DepthCheck, APushedBoxIsSeenThroughAndMaskedWholeWithoutTheFloor) {
+  const PushedBox world;
+  const auto before = world.at(0);
+  const auto now = world.at(6);  // 0.2 s: the box moved 12 cm, a fifth of its width
+  const DepthView view = viewOf(before, cameraAt(0), 0);
+  const cv::Vec4d K = intrinsics(world.camera);
+  const cv::Rect all(0, 0, world.camera.width, world.camera.height);
+  const DepthAgreement box = compareWithView(now.depth_m, now.mask, all, toMatx(cameraAt(6)), K,
+                                             view, DepthCheckOptions());
+  ASSERT_GT(box.samples, 100);
+  // Its leading fifth stands where the earlier view saw the wall behind it.
+  EXPECT_GT(box.share(box.seen_through), 0.1);
+
+  int regions = 0;
+  const cv::Mat moved = seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(),
+                                           SeenThroughOptions(), &regions);
+  const int box_px = cv::countNonZero(now.mask);
+  const int covered = cv::countNonZero(moved & now.mask);
+  const int outside = cv::countNonZero(moved & ~now.mask);
+  std::printf("box %d px: covered %d, outside %d, seen-through share %.3f\n", box_px, covered,
+              outside, box.share(box.seen_through));
+  EXPECT_EQ(regions, 1);
+  // Grown from its seen-through part into its whole surface (depth within 15 cm) ...
+  EXPECT_GT(covered, 0.9 * box_px);
+  // ... and into the floor only for the few rows within that depth range of its bottom edge.
+  EXPECT_LT(outside, 0.25 * box_px);
+}
+
+TEST(DepthCheck, DecidedObjectsAreLeftAlone) {
+  const PushedBox world;
+  const auto now = world.at(6);
+  const DepthView view = viewOf(world.at(0), cameraAt(0), 0);
+  int regions = -1;
+  const cv::Mat moved =
+      seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), intrinsics(world.camera), view, now.mask,
+                         SeenThroughOptions(), &regions);
+  EXPECT_EQ(regions, 0);
+  EXPECT_EQ(cv::countNonZero(moved), 0);
+}
+
+TEST(DepthHistory, KeepsRecentViewsAndFindsTheNewestOldEnoughOne) {
+  DepthHistory history(4);
+  const cv::Mat depth(8, 8, CV_32FC1, cv::Scalar(1.f));
+  for (long f = 0; f < 10; ++f) history.push(DepthHistory::halfView(depth, f));
+  ASSERT_NE(history.newestUpTo(7), nullptr);
+  EXPECT_EQ(history.newestUpTo(7)->frame, 7);
+  EXPECT_EQ(history.newestUpTo(100)->frame, 9);
+  ASSERT_NE(history.newestUpTo(5), nullptr);
+  EXPECT_EQ(history.newestUpTo(5)->frame, 5);
+  EXPECT_EQ(history.newestUpTo(5)->depth_m.size(), cv::Size(4, 4));  // half resolution
+  EXPECT_EQ(history.newestUpTo(4), nullptr);  // frames older than 9 - 4 are gone
+  DepthHistory off(0);
+  off.push(DepthHistory::halfView(depth, 0));
+  EXPECT_EQ(off.newestUpTo(0), nullptr);
+}
+
+}  // namespace
+}  // namespace dynamap
