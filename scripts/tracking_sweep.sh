@@ -3,7 +3,10 @@
 # into variants (start frame x frame stride), each variant is tracked with the same build and
 # config, and the ATE of each is printed, with the crowd/clean and dyn/clean ratios per variant
 # and the means over all variants. Sequences: clean teddy, teddy_dyn_dev, teddy_dyn_crowd_dev
-# and the real Bonn crowd slice (its own camera: config/bonn.yaml).
+# and the real Bonn crowd slice (its own camera: config/bonn.yaml). For the semi-synthetic
+# sequences (ground-truth masks and reference clouds) the means of the keyframe-mask and map
+# metrics over the variants follow: the masks' IoU, pixel recall and precision, the share of the
+# standing person masked, the map's precision and ghost ratio.
 # Offline runs are deterministic, but any change to tracking moves a single run's ATE by up to
 # ~0.3 cm (several cm on Bonn); the variants show whether a change helps in general.
 # usage: scripts/tracking_sweep.sh [--set key=value ...]   (12 variants; ~6 minutes on 2 cores)
@@ -20,7 +23,7 @@ rm -rf "$OUT" && mkdir -p "$OUT"
 subset() {  # subset <source dir> <dest dir> <start> <stride>: frame lists cut, files linked
   local src=$1 dst=$2 start=$3 stride=$4 f
   mkdir -p "$dst"
-  for f in rgb depth mask depth.txt groundtruth.txt; do
+  for f in rgb depth mask depth.txt mask.txt groundtruth.txt reference_static.ply reference_dynamic.ply; do
     [ -e "$src/$f" ] && ln -s "$(realpath "$src/$f")" "$dst/$f"
   done
   # Colour frames are cut; every depth frame stays listed so each keeps its associated depth.
@@ -65,3 +68,21 @@ for name in "${names[@]}"; do
   [ "$name" = teddy ] || [ -z "${sum[teddy]:-}" ] && continue
   printf 'mean %s / mean teddy: %.2f\n' "$name" "$(echo "${sum[$name]} / ${sum[teddy]}" | bc -l)"
 done
+# Masks and map over the variants (the sequences with ground-truth masks and reference clouds).
+/usr/bin/python3 - "$OUT" "${names[@]}" <<'PY'
+import glob, json, sys
+out, names = sys.argv[1], sys.argv[2:]
+keys = [("masks", "mean_iou", "IoU"), ("masks", "pixel_recall", "recall"),
+        ("masks", "pixel_precision", "precision"), ("masks", "standing_masked_share", "standing"),
+        ("map", "precision", "map_prec"), ("map", "ghost_ratio", "ghost_%")]
+print("%-6s %3s" % ("masks", "n") + "".join(" %9s" % k[2] for k in keys))
+for name in names:
+    rows = []
+    for path in sorted(glob.glob("%s/run_%s_*/metrics.json" % (out, name))):
+        m = json.load(open(path))
+        if "masks" in m and "map" in m:
+            rows.append([m[a][b] * (100 if b == "ghost_ratio" else 1) for a, b, _ in keys])
+    if rows:
+        means = [sum(c) / len(rows) for c in zip(*rows)]
+        print("%-6s %3d" % (name, len(rows)) + "".join(" %9.3f" % v for v in means))
+PY
