@@ -13,25 +13,10 @@ namespace {
 constexpr int kEdgePx = 4;
 constexpr float kEdgeM = 0.1f;
 
-/// Depth at (x, y) unless a 4-neighbour kEdgePx away has none or differs by more than kEdgeM.
-float interior(const cv::Mat& depth_m, int x, int y) {
-  const float z = depth_m.at<float>(y, x);
-  if (z <= 0.f) return 0.f;
-  const int xs[4] = {x - kEdgePx, x + kEdgePx, x, x};
-  const int ys[4] = {y, y, y - kEdgePx, y + kEdgePx};
-  for (int k = 0; k < 4; ++k) {
-    if (xs[k] < 0 || ys[k] < 0 || xs[k] >= depth_m.cols || ys[k] >= depth_m.rows) return 0.f;
-    const float n = depth_m.at<float>(ys[k], xs[k]);
-    if (n <= 0.f || std::abs(n - z) > kEdgeM) return 0.f;
-  }
-  return z;
-}
-
-enum class Verdict { kNone, kConsistent, kSeenThrough, kNearer, kOccluded };
+enum class Verdict { kNone, kConsistent, kSeenThrough, kOccluded };
 
 /// The view's depth in a window around (u, v) against the point's depth z there.
-Verdict judge(const cv::Mat& view_depth, int u, int v, int slack, float z, float margin,
-              float band) {
+Verdict judge(const cv::Mat& view_depth, int u, int v, int slack, float z, float margin) {
   float nearest = 0.f;
   bool any = false, consistent = false;
   for (int y = std::max(0, v - slack); y <= std::min(view_depth.rows - 1, v + slack); ++y) {
@@ -46,8 +31,7 @@ Verdict judge(const cv::Mat& view_depth, int u, int v, int slack, float z, float
   }
   if (!any) return Verdict::kNone;
   if (consistent) return Verdict::kConsistent;
-  if (nearest > z + margin) return Verdict::kSeenThrough;
-  return nearest >= z - band ? Verdict::kNearer : Verdict::kOccluded;
+  return nearest > z + margin ? Verdict::kSeenThrough : Verdict::kOccluded;
 }
 
 /// Median depth of the sampled pixels of group `label` (0 if none has depth).
@@ -68,6 +52,19 @@ double groupDepth(const cv::Mat& depth_m, const cv::Mat& labels, int label, cons
 
 }  // namespace
 
+float interiorDepth(const cv::Mat& depth_m, int x, int y) {
+  const float z = depth_m.at<float>(y, x);
+  if (z <= 0.f) return 0.f;
+  const int xs[4] = {x - kEdgePx, x + kEdgePx, x, x};
+  const int ys[4] = {y, y, y - kEdgePx, y + kEdgePx};
+  for (int k = 0; k < 4; ++k) {
+    if (xs[k] < 0 || ys[k] < 0 || xs[k] >= depth_m.cols || ys[k] >= depth_m.rows) return 0.f;
+    const float n = depth_m.at<float>(ys[k], xs[k]);
+    if (n <= 0.f || std::abs(n - z) > kEdgeM) return 0.f;
+  }
+  return z;
+}
+
 double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
 
 DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi,
@@ -85,7 +82,7 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
   for (int y = r.y + step / 2; y < r.y + r.height; y += step) {
     for (int x = r.x + step / 2; x < r.x + r.width; x += step) {
       if (!region.empty() && region.at<uchar>(y, x) == 0) continue;
-      const float z = interior(depth_m, x, y);
+      const float z = interiorDepth(depth_m, x, y);
       if (z <= 0.f) continue;
       const cv::Vec4d p_C((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z, 1.0);
       const cv::Vec4d p_V = T_V_C * p_C;
@@ -96,12 +93,10 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
       const double zv = p_V[2];
       const auto margin =
           static_cast<float>(k_sigma * depthNoiseM(zv) + o.pose_margin_m + o.relative_margin * zv);
-      const Verdict verdict = judge(view.depth_m, u, v, slack, static_cast<float>(zv), margin,
-                                    static_cast<float>(o.near_band_m));
+      const Verdict verdict = judge(view.depth_m, u, v, slack, static_cast<float>(zv), margin);
       if (verdict == Verdict::kNone) continue;
       ++out.samples;
       if (verdict == Verdict::kConsistent) ++out.consistent;
-      if (verdict == Verdict::kNearer) ++out.nearer;
       if (verdict == Verdict::kOccluded) ++out.occluded;
       if (verdict == Verdict::kSeenThrough) {
         ++out.seen_through;

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace dynamap {
@@ -279,9 +280,8 @@ EpipolarResult DynamicMotionFilter::checkGeometry(const FeatureMatches& m, const
 void DynamicMotionFilter::keepLastDepth(const MotionFilterInput& input) {
   if (pending_.frame != filtered_ - 1) return;
   // The last frame's final pose: X_W = T_W_C T_prev_cur^-1 X_prev.
-  const Eigen::Matrix4d T_last = (input.T_W_C * input.T_prev_cur.inverse()).matrix();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) pending_.T_W_C(r, c) = T_last(r, c);
+  cv::eigen2cv(Eigen::Matrix4d((input.T_W_C * input.T_prev_cur.inverse()).matrix()),
+               pending_.T_W_C);
   depth_history_.push(std::move(pending_));
 }
 
@@ -343,9 +343,7 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   if (m.ids.size() == m.cur_px.size()) evidence.point_ids = m.ids;
   if (input.has_prior) {
     evidence.has_pose = true;
-    const Eigen::Matrix4d T = input.T_W_C.matrix();
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) evidence.T_W_C(r, c) = T(r, c);
+    cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), evidence.T_W_C);
     evidence.K = K_;
     keepLastDepth(input);
   }

@@ -1,5 +1,7 @@
 #include "dynamap/core/dynamic/region_fusion.hpp"
 
+#include "dynamap/core/dynamic/depth_check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -51,24 +53,6 @@ double depthMode(const cv::Mat& roi, double near_m) {
   }
   std::nth_element(vals.begin(), vals.begin() + vals.size() / 2, vals.end());
   return vals[vals.size() / 2];
-}
-
-/// Depth at `p` if no pixel kEdgePx away (4-neighbourhood) differs by more than kEdgeM or has
-/// no depth, else 0: a corner on an occlusion edge slides along it as the camera moves and is
-/// no fixed point of the object.
-constexpr int kEdgePx = 4;
-constexpr float kEdgeM = 0.1f;
-float interiorDepth(const cv::Mat& depth_m, const cv::Point2f& p) {
-  const int x = cvRound(p.x), y = cvRound(p.y);
-  if (x < kEdgePx || y < kEdgePx || x >= depth_m.cols - kEdgePx || y >= depth_m.rows - kEdgePx)
-    return 0.f;
-  const float z = depth_m.at<float>(y, x);
-  for (const cv::Point o : {cv::Point(kEdgePx, 0), cv::Point(-kEdgePx, 0), cv::Point(0, kEdgePx),
-                            cv::Point(0, -kEdgePx)}) {
-    const float n = depth_m.at<float>(y + o.y, x + o.x);
-    if (n <= 0.f || std::abs(n - z) > kEdgeM) return 0.f;
-  }
-  return z;
 }
 
 bool inside(const cv::Mat& mask, const cv::Point2f& p) {
@@ -286,7 +270,8 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
     ++d.points;
     if (dyn[i]) ++d.dynamic_points;
     if (with_ids) {
-      samples.push_back({evidence_->point_ids[i], points[i], interiorDepth(depth_m, points[i])});
+      samples.push_back({evidence_->point_ids[i], points[i],
+                         interiorDepth(depth_m, cvRound(points[i].x), cvRound(points[i].y))});
     }
   }
   if (with_ids) {

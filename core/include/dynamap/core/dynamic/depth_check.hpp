@@ -19,14 +19,12 @@ struct DepthView {
 /// around that pixel (a few pixels of slack for the pose and the edges):
 /// consistent: the view saw a surface there within the noise margin (a still surface);
 /// seen_through: the view saw beyond the point everywhere around (the point was not there then:
-/// something moved in); nearer: the view saw a surface up to near_band_m in front of it (most
-/// likely this object, nearer to the camera then: it moves away); occluded: the view saw
-/// something farther in front (another object in the way).
+/// something moved in); occluded: the view saw something in front of it (an occluder, or the
+/// same surface nearer to the camera then).
 struct DepthAgreement {
   int samples = 0;  ///< sampled pixels whose point lies in the view and has depth there
   int consistent = 0;
   int seen_through = 0;
-  int nearer = 0;
   int occluded = 0;
   double share(int n) const { return samples > 0 ? static_cast<double>(n) / samples : 0.0; }
 };
@@ -39,13 +37,17 @@ struct DepthCheckOptions {
   /// ... and this share of the depth, for the sensor's low-frequency depth distortion (a few
   /// centimetres at 3 m towards the image borders on a Kinect).
   double relative_margin = 0.02;
-  int border_px = 16;        ///< pixels this close to the image border are not sampled
-  double near_band_m = 0.4;  ///< DepthAgreement::nearer: at most this in front
+  int border_px = 16;  ///< pixels this close to the image border are not sampled
 };
 
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
 /// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi, Lovell 2012, for the Kinect).
 double depthNoiseM(double z_m);
+
+/// Depth at (x, y) unless it has none or a 4-neighbour 4 px away is outside the image, has no
+/// depth or differs by more than 0.1 m (a depth edge); else 0. A point on an occlusion edge
+/// slides along it as the camera moves and is no fixed point of the surface.
+float interiorDepth(const cv::Mat& depth_m, int x, int y);
 
 /// Compares the sampled pixels of `region` (CV_8UC1, 255 = in; only inside `roi`) of the current
 /// depth (pose T_W_C, intrinsics K = fx, fy, cx, cy) with `view`. Pixels on depth edges (a
