@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -173,6 +174,7 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
 
   if (s.given_masks) s.given_masks->setNextRgbPath(entry.rgb_path);
   const TrackOutput tracked = s.system->track(frame);
+  if (options_.debug_images) logObjects(entry);
   if (tracked.is_keyframe) {
     if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, *tracked.keyframe, result);
     if (options_.save_masks) writeKeyframeMask(entry, *tracked.keyframe);
@@ -207,6 +209,17 @@ void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& fram
           ? drawMotionDebug(frame.bgr, computed->lastDiagnostics(), computed->classTable())
           : maskOverlay(frame.bgr, tracked.dynamic_mask);
   writeImageAtomic((dir / (stampName(entry.rgb_path) + ".jpg")).string(), picture);
+}
+
+void Pipeline::logObjects(const SequenceEntry& entry) {
+  const auto* computed = dynamic_cast<const DynamicMotionFilter*>(stages_->system->motionFilter());
+  if (computed == nullptr) return;
+  const fs::path dir = fs::path(options_.out_dir) / "debug";
+  fs::create_directories(dir);
+  std::ofstream log(dir / "objects.tsv", object_log_started_ ? std::ios::app : std::ios::trunc);
+  if (!object_log_started_) log << objectLogHeader();
+  object_log_started_ = true;
+  log << objectLogLines(entry.rgb_timestamp_s, computed->lastDiagnostics(), computed->classTable());
 }
 
 void Pipeline::finalize(RunResult& result) {

@@ -70,6 +70,8 @@ class Pipeline {
   void writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
                        const TrackOutput& tracked) const;
+  /// --debug-images: every frame's object decisions, appended to OUT/debug/objects.tsv.
+  void logObjects(const SequenceEntry& entry);
 
   RunOptions options_;
   AppConfig config_;
@@ -77,6 +79,7 @@ class Pipeline {
   TimingRecorder timings_;
   std::unique_ptr<Stages> stages_;
   std::string gt_masks_dir_;  ///< sequence_dir/mask when present
+  bool object_log_started_ = false;
 };
 
 }  // namespace dynamap

@@ -78,4 +78,21 @@ std::vector<int> associateDetections(const std::vector<Detection>& detections,
   return of_detection;
 }
 
+int trackSharingPoints(const std::vector<std::uint64_t>& ids,
+                       const std::vector<ObjectTrack>& tracks, int class_id, int min_shared) {
+  int best = -1, best_shared = std::max(1, min_shared) - 1;
+  for (std::size_t t = 0; t < tracks.size(); ++t) {
+    if (tracks[t].class_id != class_id) continue;
+    int shared = 0;
+    for (const std::uint64_t id : ids) {
+      const auto& a = tracks[t].anchors;
+      const auto it = std::lower_bound(
+          a.begin(), a.end(), id, [](const PointAnchor& p, std::uint64_t v) { return p.id < v; });
+      shared += it != a.end() && it->id == id;
+    }
+    if (shared > best_shared) best = static_cast<int>(t), best_shared = shared;
+  }
+  return best;
+}
+
 }  // namespace dynamap

@@ -162,14 +162,15 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
                  evidence >= config_.moving_ratio;
   // Its own points followed over time, against the pose from landmarks proven static: within
   // the pose noise (still), clearly off (moved: twice that), or in between (no verdict).
-  const double tau = config_.static_anchor_px;
+  const double tau =
+      config_.static_anchor_px + config_.static_anchor_motion_share * ev.image_motion_px;
   const bool anchored = tau > 0.0 && d.anchor.points >= kAnchorMinPoints;
   const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;
   const bool anchor_moved = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
   // Flags that the anchors contradict were measured against a wrong camera motion.
   const bool flagged_now = d.moving_now;
-  if (anchor_still) d.moving_now = false;
+  if (anchored && !anchor_moved) d.moving_now = false;
   const bool quiet = observed && d.points >= kStaticMinPoints &&
                      d.dynamic_points <= config_.static_max_dynamic_share * d.points;
   ObjectTrack t;
@@ -282,6 +283,16 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
   return region;
 }
 
+std::vector<std::uint64_t> RegionFusion::idsIn(const cv::Mat& region,
+                                               const std::vector<cv::Point2f>& points) const {
+  std::vector<std::uint64_t> ids;
+  if (evidence_->point_ids.size() != points.size()) return ids;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (inside(region, points[i])) ids.push_back(evidence_->point_ids[i]);
+  }
+  return ids;
+}
+
 void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region,
                                const cv::Rect& box, const std::vector<cv::Point2f>& points,
                                const std::vector<std::uint8_t>& dyn, FusionResult& result) const {
@@ -334,12 +345,25 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
       if (mode == FusionMode::kDetector && !classes_.isHighDynamic(d.detection.class_id)) continue;
       const cv::Rect box = clampRect(d.detection.box, depth_m.size());
       if (box.area() <= 0) continue;
-      const ObjectTrack* prev = track_of[k] >= 0 ? &tracks_[track_of[k]] : nullptr;
+      int track = track_of[k];
+      const ObjectTrack* prev = track >= 0 ? &tracks_[track] : nullptr;
       cv::Mat region = objectRegion(depth_m, box, d, points, dyn, prev);
+      if (prev == nullptr && mode == FusionMode::kBoth) {
+        // No box overlaps it enough; the points on it may still be an earlier track's.
+        track = trackSharingPoints(idsIn(region, points), tracks_, d.detection.class_id,
+                                   kAnchorMinPoints);
+        if (track >= 0) {
+          prev = &tracks_[track];
+          d = ObjectDecision{};
+          d.detection = detections[k];
+          d.weight = classes_.weight(d.detection.class_id);
+          region = objectRegion(depth_m, box, d, points, dyn, prev);
+        }
+      }
       if (mode == FusionMode::kDetector) {
         d.moving_now = d.moving = true;
       } else {
-        if (prev != nullptr) matched[track_of[k]] = true;
+        if (prev != nullptr) matched[track] = true;
         next.push_back(decideObject(d, prev, evidence));
       }
       claimed |= region;

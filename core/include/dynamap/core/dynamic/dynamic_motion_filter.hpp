@@ -114,4 +114,11 @@ DetectorOptions detectorOptions(const DynamicConfig& config);
 cv::Mat drawMotionDebug(const cv::Mat& bgr, const MotionDiagnostics& diagnostics,
                         const ClassTable& classes);
 
+/// One tab-separated line per decided object of the frame at `stamp_s` (class, score, box,
+/// points, anchors, quiet frames, decision), to follow a person's decisions over time.
+/// objectLogHeader() names the columns.
+std::string objectLogLines(double stamp_s, const MotionDiagnostics& diagnostics,
+                           const ClassTable& classes);
+std::string objectLogHeader();
+
 }  // namespace dynamap

@@ -71,4 +71,10 @@ bool medianFlowIn(const cv::Rect2f& box, const std::vector<cv::Point2f>& prev_px
 std::vector<int> associateDetections(const std::vector<Detection>& detections,
                                      const std::vector<ObjectTrack>& tracks, float min_iou);
 
+/// The track of class `class_id` whose anchors hold the most of `ids` (sorted), if at least
+/// `min_shared`: the same points followed by the flow, whatever the box became (a person half
+/// hidden behind something gets a much smaller box). -1 if none.
+int trackSharingPoints(const std::vector<std::uint64_t>& ids,
+                       const std::vector<ObjectTrack>& tracks, int class_id, int min_shared);
+
 }  // namespace dynamap

@@ -52,6 +52,9 @@ struct FusionEvidence {
   std::vector<std::uint64_t> point_ids;
   /// The camera pose (camera -> world) from landmarks proven static, and the intrinsics
   /// (fx, fy, cx, cy): an object's world position over time (has_pose false: not used).
+  /// Median image motion (px) of the proven-static points from the last frame to this one (of
+  /// all points when too few are proven): how fast the image moves.
+  double image_motion_px = 0.0;
   bool has_pose = false;
   cv::Matx44d T_W_C = cv::Matx44d::eye();
   cv::Vec4d K;
@@ -103,6 +106,9 @@ class RegionFusion {
   cv::Mat objectRegion(const cv::Mat& depth_m, const cv::Rect& box, ObjectDecision& d,
                        const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
                        const ObjectTrack* prev) const;
+  /// FusionEvidence::point_ids of the points inside `region` (empty without ids).
+  std::vector<std::uint64_t> idsIn(const cv::Mat& region,
+                                   const std::vector<cv::Point2f>& points) const;
   /// Masks (moving, static points carved out) or keeps the decided object.
   void applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                    const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
