@@ -16,21 +16,6 @@ namespace dynamap {
 
 namespace {
 
-/// Median |cur - prev| of the proven-static matches (of all when fewer than 10 are proven).
-double imageMotionPx(const FeatureMatches& m, const std::vector<std::uint8_t>& proven) {
-  std::vector<double> all, still;
-  for (std::size_t i = 0; i < m.cur_px.size() && i < m.prev_px.size(); ++i) {
-    const double d = cv::norm(m.cur_px[i] - m.prev_px[i]);
-    all.push_back(d);
-    if (i < proven.size() && proven[i] != 0) still.push_back(d);
-  }
-  std::vector<double>& v = still.size() >= 10 ? still : all;
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
@@ -355,7 +340,6 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   evidence.flags_valid = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
   evidence.prev_points = m.prev_px;
   if (input.proven_static != nullptr) evidence.proven_static = *input.proven_static;
-  evidence.image_motion_px = imageMotionPx(m, evidence.proven_static);
   if (m.ids.size() == m.cur_px.size()) evidence.point_ids = m.ids;
   if (input.has_prior) {
     evidence.has_pose = true;

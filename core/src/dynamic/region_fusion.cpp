@@ -162,8 +162,7 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
                  evidence >= config_.moving_ratio;
   // Its own points followed over time, against the pose from landmarks proven static: within
   // the pose noise (still), clearly off (moved: twice that), or in between (no verdict).
-  const double tau =
-      config_.static_anchor_px + config_.static_anchor_motion_share * ev.image_motion_px;
+  const double tau = config_.static_anchor_px;
   const bool anchored = tau > 0.0 && d.anchor.points >= kAnchorMinPoints;
   const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;

@@ -98,10 +98,6 @@ struct DynamicConfig {
   /// This replaces the centroid test where it applies: a person swaying 5 cm on the spot moves
   /// its points by several pixels, while its centroid wanders that much with occlusion alone.
   double static_anchor_px = 3.0;
-  /// ... plus this share of the frame's image motion (median flow of the proven-static points,
-  /// px): a rolling shutter and time-stamp offsets shift a still object against the fitted pose
-  /// by a share of how fast the image moves, while a sway or a step shows at any camera speed.
-  double static_anchor_motion_share = 0.0;
   /// ... and their signed median depth difference within this (m): a sway along the line of
   /// sight. Twice either threshold is motion: the count of quiet frames starts over.
   double static_anchor_depth_m = 0.03;

@@ -52,9 +52,6 @@ struct FusionEvidence {
   std::vector<std::uint64_t> point_ids;
   /// The camera pose (camera -> world) from landmarks proven static, and the intrinsics
   /// (fx, fy, cx, cy): an object's world position over time (has_pose false: not used).
-  /// Median image motion (px) of the proven-static points from the last frame to this one (of
-  /// all points when too few are proven): how fast the image moves.
-  double image_motion_px = 0.0;
   bool has_pose = false;
   cv::Matx44d T_W_C = cv::Matx44d::eye();
   cv::Vec4d K;
