@@ -1,6 +1,8 @@
 // An object's identity over time is its tracked points: a person half hidden behind something
 // keeps the evidence gathered on it, and the point anchors, not one frame's flags, tell whether
 // a kept person moved.
+#include <functional>
+
 #include <gtest/gtest.h>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
@@ -57,27 +59,37 @@ TEST(TrackIdentity, TheTrackHoldingMostOfThePointsOfTheSameClass) {
   EXPECT_EQ(trackSharingPoints({1, 2, 3}, tracks, 77, 3), 2);
 }
 
+/// Runs `frames` frames of one RegionFusion; `frame(s, i)` sets up frame i's scene and returns
+/// its detections. Returns whether the first object is masked in each frame from `from` on.
+std::vector<bool> maskedFrom(int frames, int from,
+                             const std::function<std::vector<Detection>(Scene&, int)>& frame) {
+  DynamicConfig c;
+  RegionFusion fusion(c, ClassTable(c));
+  std::vector<bool> masked;
+  for (int i = 0; i < frames; ++i) {
+    Scene s;
+    const std::vector<Detection> dets = frame(s, i);
+    const bool m = s.fuse(fusion, dets).objects.at(0).moving;
+    if (i == from - 1) {
+      EXPECT_FALSE(m) << "confirmed still before frame " << from;
+    }
+    if (i >= from) masked.push_back(m);
+  }
+  return masked;
+}
+
 /// Frames 0-9 a person stands 2 m away, fully seen; from frame 10 a crate 1 m away hides all
 /// but their head (a box of a quarter of the IoU association needs). Returns whether they are
 /// masked in frames 10-14.
 std::vector<bool> hiddenPersonMasked(bool with_ids) {
   const cv::Rect person(280, 100, 80, 280), head(280, 100, 80, 60);
   const cv::Rect crate(200, 170, 240, 300);
-  DynamicConfig c;
-  RegionFusion fusion(c, ClassTable(c));
-  std::vector<bool> masked;
-  for (int i = 0; i < 15; ++i) {
-    Scene s;
+  return maskedFrom(15, 10, [&](Scene& s, int i) {
     if (!with_ids) s.ev.point_ids.clear();
     s.depth(person).setTo(2.f);
     if (i >= 10) s.depth(crate).setTo(1.f);
-    const FusionResult r = s.fuse(fusion, {box(i < 10 ? person : head)});
-    if (i == 9) {
-      EXPECT_FALSE(r.objects.at(0).moving) << "confirmed still before it was hidden";
-    }
-    if (i >= 10) masked.push_back(r.objects.at(0).moving);
-  }
-  return masked;
+    return std::vector<Detection>{box(i < 10 ? person : head)};
+  });
 }
 
 TEST(TrackIdentity, AHalfHiddenStandingPersonKeepsTheEvidenceOnItsPoints) {
@@ -92,17 +104,11 @@ TEST(TrackIdentity, AHalfHiddenStandingPersonKeepsTheEvidenceOnItsPoints) {
 /// 10-15.
 std::vector<bool> maskedAfterOneFlaggedFrame(float jump_px) {
   const cv::Rect person(280, 100, 80, 280);
-  DynamicConfig c;
-  RegionFusion fusion(c, ClassTable(c));
-  std::vector<bool> masked;
-  for (int i = 0; i < 16; ++i) {
-    Scene s;
+  return maskedFrom(16, 10, [&](Scene& s, int i) {
     s.depth(person).setTo(2.f);
     if (i == 10) s.disturb(person, jump_px);
-    const bool m = s.fuse(fusion, {box(person)}).objects.at(0).moving;
-    if (i >= 10) masked.push_back(m);
-  }
-  return masked;
+    return std::vector<Detection>{box(person)};
+  });
 }
 
 TEST(TrackIdentity, OneFlaggedFrameTheAnchorsDoNotConfirmMasksButDoesNotRestartTheCount) {

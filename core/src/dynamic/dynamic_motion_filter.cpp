@@ -302,6 +302,7 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
     cv::dilate(moved, moved, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
   }
   fused.mask |= moved;
+  if (!fused.unconfirmed.empty()) fused.unconfirmed.setTo(0, moved);
 }
 
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
@@ -361,6 +362,11 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     const bool lone_flag = epi.is_dynamic[i] && !inMask(fused.static_objects, m.cur_px[i]);
     out.match_is_dynamic[i] = (lone_flag || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
   }
+  out.match_held.assign(m.cur_px.size(), 0);
+  for (std::size_t i = 0; i < m.cur_px.size() && !fused.unconfirmed.empty(); ++i) {
+    out.match_held[i] = !epi.is_dynamic[i] && inMask(fused.unconfirmed, m.cur_px[i]) ? 1 : 0;
+  }
+  out.unconfirmed_mask = fused.unconfirmed;
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
   prev_mask_ = fused.mask;
   pending_ = DepthView();

@@ -3,6 +3,16 @@
 #include <algorithm>
 
 namespace dynamap {
+namespace {
+
+/// The anchor of point `id` in `anchors` (sorted by id), or null.
+const PointAnchor* findAnchor(const std::vector<PointAnchor>& anchors, std::uint64_t id) {
+  const auto it = std::lower_bound(anchors.begin(), anchors.end(), id,
+                                   [](const PointAnchor& a, std::uint64_t v) { return a.id < v; });
+  return it != anchors.end() && it->id == id ? &*it : nullptr;
+}
+
+}  // namespace
 
 AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
                          const std::vector<PointSample>& now, const cv::Matx44d& T_W_C,
@@ -17,10 +27,8 @@ AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
     const cv::Vec4d p_W = T_W_C * p_C;
     const PointAnchor here{s.id, cv::Vec3d(p_W[0], p_W[1], p_W[2])};
     out.fresh.push_back(here);
-    const auto it =
-        std::lower_bound(anchors.begin(), anchors.end(), s.id,
-                         [](const PointAnchor& a, std::uint64_t id) { return a.id < id; });
-    if (it == anchors.end() || it->id != s.id) {
+    const PointAnchor* it = findAnchor(anchors, s.id);
+    if (it == nullptr) {
       out.kept.push_back(here);
       continue;
     }
@@ -84,12 +92,7 @@ int trackSharingPoints(const std::vector<std::uint64_t>& ids,
   for (std::size_t t = 0; t < tracks.size(); ++t) {
     if (tracks[t].class_id != class_id) continue;
     int shared = 0;
-    for (const std::uint64_t id : ids) {
-      const auto& a = tracks[t].anchors;
-      const auto it = std::lower_bound(
-          a.begin(), a.end(), id, [](const PointAnchor& p, std::uint64_t v) { return p.id < v; });
-      shared += it != a.end() && it->id == id;
-    }
+    for (const std::uint64_t id : ids) shared += findAnchor(tracks[t].anchors, id) != nullptr;
     if (shared > best_shared) best = static_cast<int>(t), best_shared = shared;
   }
   return best;

@@ -167,7 +167,8 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;
   const bool anchor_moved = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
-  // Flags that the anchors contradict were measured against a wrong camera motion.
+  // Flags the anchors do not confirm were measured against a wrong camera motion: they mask
+  // the object in this frame (below) but restart neither its quiet count nor its anchors.
   const bool flagged_now = d.moving_now;
   if (anchored && !anchor_moved) d.moving_now = false;
   const bool quiet = observed && d.points >= kStaticMinPoints &&
@@ -226,7 +227,10 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   if (classes_.isHighDynamic(d.detection.class_id)) {
     // Anchors off by more than the pose noise mask it in this frame (its count is kept).
     const int needed = config_.static_confirm_frames << std::min(t.slow_moves, kMaxSlowDoublings);
-    t.moving = t.moving || t.quiet_frames < needed || (anchored && !anchor_still);
+    const bool evidenced = t.moving || (anchored && !anchor_still);
+    t.moving = evidenced || t.quiet_frames < needed;
+    d.unconfirmed = t.moving && !evidenced && !flagged_now && t.slow_moves == 0 &&
+                    t.score < config_.moving_ratio;
   }
   d.moving = t.moving;
   d.quiet_frames = t.quiet_frames;
@@ -299,8 +303,16 @@ void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& regi
     carveStatic(region, box, points, dyn, proven_, config_.static_carve_radius_px);
   }
   (d.moving ? result.mask : result.static_objects) |= region;
+  if (d.moving) (d.unconfirmed ? result.unconfirmed : certain_) |= region;
   if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) confirmed_ |= region;
   result.objects.push_back(d);
+}
+
+ObjectDecision RegionFusion::newDecision(const Detection& detection) const {
+  ObjectDecision d;
+  d.detection = detection;
+  d.weight = classes_.weight(detection.class_id);
+  return d;
 }
 
 std::vector<Detection> RegionFusion::oneLabelPerObject(const std::vector<Detection>& in) const {
@@ -328,6 +340,8 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
   proven_ = evidence.proven_static;
   evidence_ = &evidence;
   confirmed_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  certain_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  result.unconfirmed = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.static_objects = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
@@ -337,9 +351,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     const std::vector<int> track_of = associateDetections(detections, tracks_, kMatchIou);
     std::vector<bool> matched(tracks_.size(), false);
     for (std::size_t k = 0; k < detections.size(); ++k) {
-      ObjectDecision d;
-      d.detection = detections[k];
-      d.weight = classes_.weight(d.detection.class_id);
+      ObjectDecision d = newDecision(detections[k]);
       if (d.weight <= 0.0) continue;
       if (mode == FusionMode::kDetector && !classes_.isHighDynamic(d.detection.class_id)) continue;
       const cv::Rect box = clampRect(d.detection.box, depth_m.size());
@@ -353,9 +365,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                    kAnchorMinPoints);
         if (track >= 0) {
           prev = &tracks_[track];
-          d = ObjectDecision{};
-          d.detection = detections[k];
-          d.weight = classes_.weight(d.detection.class_id);
+          d = newDecision(detections[k]);
           region = objectRegion(depth_m, box, d, points, dyn, prev);
         }
       }
@@ -377,9 +387,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
           box.area() * 4 < track.box.area()) {
         continue;
       }
-      ObjectDecision d;
-      d.detection = Detection{track.box, track.class_id, 0.f};
-      d.weight = classes_.weight(track.class_id);
+      ObjectDecision d = newDecision(Detection{track.box, track.class_id, 0.f});
       d.carried = true;
       cv::Mat region = objectRegion(depth_m, box, d, points, dyn, &track);
       next.push_back(decideObject(d, &track, evidence));
@@ -393,8 +401,12 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
   // teddy (or a standing person) must not take its depth cut.
   if (cv::countNonZero(confirmed_) > 0) result.mask.setTo(0, confirmed_);
   if (mode != FusionMode::kDetector && evidence.flags_valid) {
-    result.clusters = growClusters(depth_m, points, dyn, claimed, result.mask);
+    cv::Mat grown = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+    result.clusters = growClusters(depth_m, points, dyn, claimed, grown);
+    result.mask |= grown;
+    certain_ |= grown;
   }
+  result.unconfirmed.setTo(0, certain_ | confirmed_);
   if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {
     const int k = 2 * config_.mask_dilation_px + 1;
     cv::dilate(result.mask, result.mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));

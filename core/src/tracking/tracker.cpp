@@ -56,7 +56,9 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   const MotionFilterOutput filtered =
       runMotionFilter(frame, gray, matches, has_prior ? &T_W_C_prior : nullptr);
   result.dynamic_mask = filtered.dynamic_mask;
-  result.dynamic_matches = dropDynamic(matches, filtered);
+  MotionFilterOutput widened = filtered;
+  widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
+  result.dynamic_matches = dropDynamic(matches, widened);
   result.tracked_features = static_cast<int>(tracks_.size());
 
   Eigen::Isometry3d T_W_C = T_W_C_pred;
@@ -66,7 +68,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     tracks_.clear();
     // The first frame starts the map at the origin; a restart after a long loss starts a new
     // part of the map where the camera was last seen.
-    result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered.dynamic_mask);
+    result.keyframe =
+        createKeyframe(frame, gray, T_W_last_, filtered.dynamic_mask, initialMask(gray, widened));
     if (result.keyframe) {
       initialized_ = true;
       lost_streak_ = 0;
@@ -74,9 +77,12 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
       result.T_W_C = T_W_last_;
       result.inliers = static_cast<int>(tracks_.size());
     }
-  } else if (estimatePose(frame, T_W_C, result.inliers)) {
+  } else if (estimatePose(frame, T_W_C, result.inliers) ||
+             rescuePose(frame, T_W_C, result.inliers)) {
     result.status = FrameStatus::kTracked;
-  } else if (relocalize(frame, gray, filtered.dynamic_mask, T_W_C, result.inliers)) {
+  } else if (relocalize(frame, gray, widened.dynamic_mask, T_W_C, result.inliers) ||
+             (!held_.empty() &&
+              relocalize(frame, gray, certainMask(widened), T_W_C, result.inliers))) {
     result.status = FrameStatus::kRelocalized;
   } else {
     result.status = FrameStatus::kLost;
@@ -85,7 +91,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   if (initialized_ && result.status != FrameStatus::kLost && !result.keyframe) {
     result.T_W_C = T_W_C;
     if (needKeyframe(frame.timestamp_s, T_W_C)) {
-      result.keyframe = createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask);
+      result.keyframe =
+          createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask, widened.dynamic_mask);
     }
   }
   if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);
@@ -268,11 +275,56 @@ MotionFilterOutput Tracker::Impl::runMotionFilter(const RgbdFrame& frame, const 
   return filter_->filter(input);
 }
 
+cv::Mat Tracker::Impl::widenedMask(const cv::Mat& dynamic_mask) const {
+  const int r = config_.dynamic_margin_px;
+  if (r <= 0 || dynamic_mask.empty() || cv::countNonZero(dynamic_mask) == 0) return dynamic_mask;
+  // Distance to the nearest masked pixel: one pass, whatever the margin (a dilation with a
+  // disc of 2r+1 costs r times more).
+  cv::Mat dist;
+  cv::distanceTransform(dynamic_mask != 255, dist, cv::DIST_L2, 3);
+  cv::Mat widened = dist <= static_cast<float>(r);
+  return widened;
+}
+
+// Pose from the tracks the motion filter held back only for lack of proof that their object
+// stands still, with the others: a last resort when the rest of the image cannot hold a pose
+// (a teddy taken for a person at start-up, in front of walkers). RANSAC still drops movers.
+bool Tracker::Impl::rescuePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers) {
+  if (held_.empty()) return false;
+  const std::size_t own = tracks_.size();
+  tracks_.insert(tracks_.end(), held_.begin(), held_.end());
+  if (estimatePose(frame, T_W_C, inliers)) return true;
+  tracks_.resize(own);
+  return false;
+}
+
+// The map starts from the features outside the motion regions; when those are too few to
+// track with (fewer than min_tracked_features: a teddy taken for a person fills the view at
+// start-up), from those outside the regions with evidence of motion. Nothing has shown it
+// stands still yet on a first frame, so movers among them are left to RANSAC and to
+// cullMovedLandmarks().
+cv::Mat Tracker::Impl::initialMask(const cv::Mat& gray, const MotionFilterOutput& out) {
+  if (out.unconfirmed_mask.empty() || cv::countNonZero(out.unconfirmed_mask) == 0) {
+    return out.dynamic_mask;
+  }
+  const std::size_t outside = extractOrb(gray, out.dynamic_mask).keypoints.size();
+  if (static_cast<int>(outside) >= config_.min_tracked_features) return out.dynamic_mask;
+  return certainMask(out);
+}
+
+cv::Mat Tracker::Impl::certainMask(const MotionFilterOutput& out) const {
+  if (out.unconfirmed_mask.empty() || out.dynamic_mask.empty()) return out.dynamic_mask;
+  cv::Mat certain = out.dynamic_mask.clone();
+  certain.setTo(0, out.unconfirmed_mask);
+  return certain;
+}
+
 int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out) {
   // The landmark tracks come first in `matches`, the motion probes after them.
   const bool has_flags = out.match_is_dynamic.size() == matches.cur_px.size() &&
                          out.match_is_dynamic.size() >= tracks_.size();
   const bool has_mask = !out.dynamic_mask.empty() && out.dynamic_mask.type() == CV_8UC1;
+  held_.clear();
   if (!has_flags && !has_mask) return 0;
   int dropped = 0;
   dropped_.clear();
@@ -289,6 +341,7 @@ int Tracker::Impl::dropDynamic(const FeatureMatches& matches, const MotionFilter
     if (dynamic) {
       ++dropped;
       dropped_.push_back(tracks_[i]);
+      if (i < out.match_held.size() && out.match_held[i] != 0) held_.push_back(tracks_[i]);
     } else {
       kept.push_back(tracks_[i]);
     }

@@ -161,8 +161,9 @@ std::vector<int> Tracker::Impl::searchLocalMap(const OrbFeatures& features,
 
 KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                                 const Eigen::Isometry3d& T_W_C,
-                                                const cv::Mat& dynamic_mask) {
-  const OrbFeatures features = extractOrb(gray, dynamic_mask);
+                                                const cv::Mat& dynamic_mask,
+                                                const cv::Mat& track_mask) {
+  const OrbFeatures features = extractOrb(gray, track_mask);
   const double max_landmark_m = std::min(config_.depth_max_m, config_.landmark_depth_max_m);
   std::vector<double> depth(features.keypoints.size());
   for (std::size_t i = 0; i < features.keypoints.size(); ++i) {

@@ -43,6 +43,11 @@ struct MotionFilterInput {
 struct MotionFilterOutput {
   std::vector<std::uint8_t> match_is_dynamic;  ///< one flag per match (1 = dynamic)
   cv::Mat dynamic_mask;  ///< CV_8UC1, 255 = moving region; empty = nothing moving
+  /// Per match (may be empty): dynamic only for lack of proof that it is still (an object of a
+  /// moving class not yet confirmed static) and not flagged itself. The tracker may use these
+  /// when the rest of the image cannot hold a pose.
+  std::vector<std::uint8_t> match_held;
+  cv::Mat unconfirmed_mask;  ///< CV_8UC1 (may be empty): the pixels behind match_held
 };
 
 /// Hook between feature matching and pose estimation. The tracker drops dynamic matches and

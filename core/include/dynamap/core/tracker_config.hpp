@@ -32,6 +32,10 @@ struct TrackerConfig {
   /// tracked landmarks that at least this many keyframes observed (those proven static over
   /// time), when there are enough of them (0 = no prior: the filter fits the motion itself).
   int static_prior_min_keyframes = 2;
+  /// Features this close (px) to a motion region take no part in pose estimation nor become
+  /// landmarks: an LK window half on a passing person is dragged along with it. The map's mask
+  /// is not widened by it. 0 = the motion regions only.
+  int dynamic_margin_px = 0;
 
   // --- depth ---
   double depth_min_m = 0.1;  ///< depth readings outside [min, max] are ignored

@@ -27,8 +27,11 @@ struct ObjectDecision {
   bool moving_now = false;  ///< evidence in this frame
   bool moving = false;      ///< after hysteresis (what is masked)
   bool carried = false;     ///< not detected in this frame: its track carried by the flow
-  int quiet_frames = 0;     ///< observed frames with static evidence since it last moved
-  double depth_m = 0.0;     ///< depth mode of the object (0 = no depth)
+  /// Masked only because it has not yet shown that it stands still: nothing of its own (flags,
+  /// smoothed evidence, anchors, slow moves) says it moves.
+  bool unconfirmed = false;
+  int quiet_frames = 0;  ///< observed frames with static evidence since it last moved
+  double depth_m = 0.0;  ///< depth mode of the object (0 = no depth)
   bool has_position = false;
   cv::Vec3d p_W;       ///< centroid of its pixels in the world (with FusionEvidence::has_pose)
   AnchorCheck anchor;  ///< its points against their world anchors (with point ids and a pose)
@@ -60,6 +63,9 @@ struct FusionEvidence {
 struct FusionResult {
   cv::Mat mask;            ///< CV_8UC1, 255 = moving
   cv::Mat static_objects;  ///< CV_8UC1, 255 = pixels of detected objects decided not moving
+  /// CV_8UC1, 255 = masked pixels of unconfirmed objects only (ObjectDecision::unconfirmed):
+  /// what the tracker may fall back on when the rest of the image cannot hold a pose.
+  cv::Mat unconfirmed;
   std::vector<ObjectDecision> objects;
   int clusters = 0;      ///< dynamic-point clusters grown into regions outside objects
   int seen_through = 0;  ///< regions the dense check added (DynamicMotionFilter)
@@ -93,6 +99,8 @@ class RegionFusion {
   /// Drops a high-dynamic detection that overlaps (IoU >= 0.6) a better-scored detection of a
   /// class that does not move by itself: the detector's two labels of one object.
   std::vector<Detection> oneLabelPerObject(const std::vector<Detection>& in) const;
+  /// A decision on `detection` with its class's weight, nothing measured yet.
+  ObjectDecision newDecision(const Detection& detection) const;
   /// Moves every track's box by the median flow of the points inside it.
   void propagateTracks(const std::vector<cv::Point2f>& points, const FusionEvidence& evidence);
   /// Decides `d` given its track in the last frame (null: new object); returns its new track.
@@ -118,7 +126,9 @@ class RegionFusion {
   ClassTable classes_;
   std::vector<ObjectTrack> tracks_;
   std::vector<std::uint8_t> proven_;  ///< this frame's FusionEvidence::proven_static
-  cv::Mat confirmed_;                 ///< this frame's pixels of objects confirmed static over time
+  cv::Mat confirmed_;
+  cv::Mat certain_;  ///< this frame's moving pixels with evidence of their own                 ///<
+                     ///< this frame's pixels of objects confirmed static over time
   const FusionEvidence* evidence_ = nullptr;  ///< during fuse()
 };
 

@@ -57,6 +57,14 @@ class Tracker::Impl {
                                      const FeatureMatches& matches,
                                      const Eigen::Isometry3d* T_W_C_prior);
   int dropDynamic(const FeatureMatches& matches, const MotionFilterOutput& out);
+  /// The motion mask grown by config_.dynamic_margin_px: what pose estimation keeps away from.
+  cv::Mat widenedMask(const cv::Mat& dynamic_mask) const;
+  /// estimatePose() with the held-back tracks added; tracks_ unchanged if it fails.
+  bool rescuePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The mask the first keyframe of a map takes its landmarks outside of.
+  cv::Mat initialMask(const cv::Mat& gray, const MotionFilterOutput& out);
+  /// `out`'s mask without its unconfirmed objects.
+  cv::Mat certainMask(const MotionFilterOutput& out) const;
   void cullMovedLandmarks(const Eigen::Isometry3d& T_W_C);
   bool estimatePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
   /// The pose against the tracked landmarks proven static over time (seen by at least
@@ -67,8 +75,10 @@ class Tracker::Impl {
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const;
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
                                   const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
+  /// New landmarks come from outside `track_mask`; the packet carries `dynamic_mask`.
   KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
-                                   const Eigen::Isometry3d& T_W_C, const cv::Mat& dynamic_mask);
+                                   const Eigen::Isometry3d& T_W_C, const cv::Mat& dynamic_mask,
+                                   const cv::Mat& track_mask);
   OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
   void record(double timestamp_s, FrameStatus status, const Eigen::Isometry3d& T_W_C);
   void countStatus(FrameStatus status, bool keyframe);
@@ -85,6 +95,7 @@ class Tracker::Impl {
   cv::Mat prev_gray_;
   std::vector<FeatureTrack> tracks_;   ///< parallel to the matches of the current frame
   std::vector<FeatureTrack> dropped_;  ///< tracks the motion filter dropped this frame
+  std::vector<FeatureTrack> held_;     ///< of which only held back (MotionFilterOutput::match_held)
   /// Per track this frame: a landmark seen by static_prior_min_keyframes keyframes that fits
   /// priorPose() (set by priorPose(), read by runMotionFilter()).
   std::vector<std::uint8_t> proven_static_;
