@@ -88,7 +88,7 @@ struct TrackerConfig {
   int reloc_min_inliers = 20;  ///< inliers needed to accept a relocalization
   /// After this many frames lost in a row the map restarts where the camera was last seen
   /// (0 = never: stay lost until relocalization succeeds).
-  int restart_after_lost_frames = 15;
+  int restart_after_lost_frames = 5;
 };
 
 }  // namespace dynamap
