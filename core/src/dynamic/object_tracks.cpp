@@ -27,13 +27,13 @@ AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
     const cv::Vec4d p_W = T_W_C * p_C;
     const PointAnchor here{s.id, cv::Vec3d(p_W[0], p_W[1], p_W[2])};
     out.fresh.push_back(here);
-    const PointAnchor* it = findAnchor(anchors, s.id);
-    if (it == nullptr) {
+    const PointAnchor* anchor = findAnchor(anchors, s.id);
+    if (anchor == nullptr) {
       out.kept.push_back(here);
       continue;
     }
-    out.kept.push_back(*it);
-    const cv::Vec4d q = T_C_W * cv::Vec4d(it->p_W[0], it->p_W[1], it->p_W[2], 1.0);
+    out.kept.push_back(*anchor);
+    const cv::Vec4d q = T_C_W * cv::Vec4d(anchor->p_W[0], anchor->p_W[1], anchor->p_W[2], 1.0);
     if (q[2] <= 0.05) continue;
     const cv::Point2f uv(static_cast<float>(K[0] * q[0] / q[2] + K[2]),
                          static_cast<float>(K[1] * q[1] / q[2] + K[3]));

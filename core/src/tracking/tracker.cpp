@@ -282,8 +282,7 @@ cv::Mat Tracker::Impl::widenedMask(const cv::Mat& dynamic_mask) const {
   // disc of 2r+1 costs r times more).
   cv::Mat dist;
   cv::distanceTransform(dynamic_mask != 255, dist, cv::DIST_L2, 3);
-  cv::Mat widened = dist <= static_cast<float>(r);
-  return widened;
+  return dist <= static_cast<float>(r);
 }
 
 // Pose from the tracks the motion filter held back only for lack of proof that their object

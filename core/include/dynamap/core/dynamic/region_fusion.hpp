@@ -126,9 +126,8 @@ class RegionFusion {
   ClassTable classes_;
   std::vector<ObjectTrack> tracks_;
   std::vector<std::uint8_t> proven_;  ///< this frame's FusionEvidence::proven_static
-  cv::Mat confirmed_;
-  cv::Mat certain_;  ///< this frame's moving pixels with evidence of their own                 ///<
-                     ///< this frame's pixels of objects confirmed static over time
+  cv::Mat confirmed_;                 ///< this frame's pixels of objects confirmed static over time
+  cv::Mat certain_;                   ///< this frame's moving pixels with evidence of their own
   const FusionEvidence* evidence_ = nullptr;  ///< during fuse()
 };
 
