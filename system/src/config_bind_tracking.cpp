@@ -41,6 +41,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_rotation_deg", &c.kf_max_rotation_deg, 0.1, 180.0);
   schema.addDouble("tracking.kf_max_parallax_px", &c.kf_max_parallax_px, 1.0, 1000.0);
   schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
+  schema.addDouble("tracking.kf_max_masked_share", &c.kf_max_masked_share, 0.0, 1.0);
 
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);

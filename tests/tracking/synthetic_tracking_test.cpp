@@ -334,3 +334,79 @@ TEST(SyntheticTracking, AMapStartsOnUnconfirmedObjectsWhenTheRestIsTooLittleToTr
 
 }  // namespace
 }  // namespace dynamap
+
+namespace dynamap {
+namespace {
+
+/// Masks `region` (as moving) in frames [first, last] only.
+class CrowdedSpanFilter : public MotionFilter {
+ public:
+  CrowdedSpanFilter(cv::Mat region, int first, int last)
+      : region_(std::move(region)), first_(first), last_(last) {}
+  void beginFrame(const RgbdFrame&) override {}
+  MotionFilterOutput filter(const MotionFilterInput& input) override {
+    const bool crowded = frame_ >= first_ && frame_ <= last_;
+    ++frame_;
+    MotionFilterOutput out;
+    if (crowded) out.dynamic_mask = region_;
+    for (const auto& p : input.matches->cur_px) {
+      out.match_is_dynamic.push_back(crowded &&
+                                     region_.at<std::uint8_t>(cvRound(p.y), cvRound(p.x)) == 255);
+    }
+    return out;
+  }
+
+ private:
+  cv::Mat region_;
+  int first_, last_, frame_ = 0;
+};
+
+struct CrowdedRun {
+  int keyframes_in_span = 0, tracked = 0;
+  double worst_m = 0.0;
+};
+
+/// 40 frames of the room on a slow path (~4 mm a frame: the motion limits make a keyframe every
+/// 20 frames); in frames 10-25 movers fill the left 60 % of the image.
+CrowdedRun trackThroughACrowd(double kf_max_masked_share) {
+  constexpr int kSlow = 300;
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 23);
+  scene.addDefaultRoom();
+  cv::Mat region = cv::Mat::zeros(camera.height, camera.width, CV_8UC1);
+  region(cv::Rect(0, 0, camera.width * 6 / 10, camera.height)).setTo(255);
+  CrowdedSpanFilter filter(region, 10, 25);
+  TrackerConfig config;
+  config.kf_max_masked_share = kf_max_masked_share;
+  Tracker tracker(camera, config, nullptr);
+  tracker.setMotionFilter(&filter);
+  CrowdedRun run;
+  for (int i = 0; i < 40; ++i) {
+    const auto r = scene.render(test::smoothPath(i, kSlow), i * kFramePeriodS);
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    run.tracked += res.status == FrameStatus::kTracked;
+    run.keyframes_in_span += res.is_keyframe && i >= 10 && i <= 25;
+  }
+  tracker.finish();
+  const auto traj = tracker.finalTrajectory();
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const Eigen::Isometry3d truth =
+        test::smoothPath(0, kSlow).inverse() * test::smoothPath(static_cast<int>(i), kSlow);
+    run.worst_m =
+        std::max(run.worst_m, (traj[i].second.translation() - truth.translation()).norm());
+  }
+  return run;
+}
+
+TEST(SyntheticTracking, FramesTheMoversFillMakeKeyframesOnlyForMotionNotForLackOfTracks) {
+  const CrowdedRun always = trackThroughACrowd(1.0);
+  const CrowdedRun crowded = trackThroughACrowd(0.35);
+  // Masking 60 % of the view drops the tracks below the keyframe limits at once: without the
+  // share limit a keyframe follows; with it, only the motion and time limits make one.
+  EXPECT_GT(always.keyframes_in_span, crowded.keyframes_in_span);
+  EXPECT_EQ(crowded.tracked, 40);
+  EXPECT_LT(crowded.worst_m, 0.015);
+}
+
+}  // namespace
+}  // namespace dynamap

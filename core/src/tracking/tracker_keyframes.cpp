@@ -111,9 +111,12 @@ bool Tracker::Impl::relocalize(const RgbdFrame& frame, const cv::Mat& gray,
 }
 
 bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const {
-  if (static_cast<int>(tracks_.size()) < config_.min_tracked_features) return true;
-  if (static_cast<double>(tracks_.size()) <
-      config_.kf_min_tracked_ratio * static_cast<double>(ref_tracks_)) {
+  // Few tracks in a frame the movers fill mean nothing new to map: what is left unmasked is
+  // little and near the movers, and the tracks come back when they leave.
+  const bool crowded = masked_share_ > config_.kf_max_masked_share;
+  if (!crowded && static_cast<int>(tracks_.size()) < config_.min_tracked_features) return true;
+  if (!crowded && static_cast<double>(tracks_.size()) <
+                      config_.kf_min_tracked_ratio * static_cast<double>(ref_tracks_)) {
     return true;
   }
   const Eigen::Isometry3d T_ref_C = ref_T_W_C_.inverse() * T_W_C;
