@@ -58,7 +58,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   result.dynamic_mask = filtered.dynamic_mask;
   // Held-back objects (a teddy taken for a person) are no movers: they do not count.
   const cv::Mat certain = certainMask(filtered);
-  masked_share_ = certain.empty() ? 0.0 : cv::countNonZero(certain) / double(certain.total());
+  masked_share_ =
+      certain.empty() ? 0.0 : cv::countNonZero(certain) / static_cast<double>(certain.total());
   MotionFilterOutput widened = filtered;
   widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
   result.dynamic_matches = dropDynamic(matches, widened);

@@ -63,9 +63,10 @@ struct TrackerConfig {
   double kf_max_rotation_deg = 8.0;    ///< camera rotated more than this from the reference
   double kf_max_parallax_px = 40.0;    ///< median feature displacement since the reference
   double kf_max_interval_s = 1.0;      ///< time since the reference keyframe
-  /// A frame whose dynamic mask covers more than this share of the image makes no keyframe for
-  /// lack of tracks (min_tracked_features, kf_min_tracked_ratio), only for the motion, time and
-  /// parallax limits above (1 = always).
+  /// A frame whose dynamic mask, held-back objects left out (MotionFilterOutput::
+  /// unconfirmed_mask), covers more than this share of the image makes no keyframe for lack of
+  /// tracks (min_tracked_features, kf_min_tracked_ratio), only for the motion, time and parallax
+  /// limits above (1 = always).
   double kf_max_masked_share = 0.35;
 
   // --- local bundle adjustment (own thread) ---

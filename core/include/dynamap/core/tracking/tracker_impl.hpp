@@ -108,7 +108,7 @@ class Tracker::Impl {
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
-  double masked_share_ = 0.0;  ///< share of this frame's image under its dynamic mask
+  double masked_share_ = 0.0;  ///< share of this frame's image under its certainMask()
 
   std::uint64_t ref_kf_ = 0;
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
