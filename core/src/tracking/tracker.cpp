@@ -56,10 +56,6 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   const MotionFilterOutput filtered =
       runMotionFilter(frame, gray, matches, has_prior ? &T_W_C_prior : nullptr);
   result.dynamic_mask = filtered.dynamic_mask;
-  // Held-back objects (a teddy taken for a person) are no movers: they do not count.
-  const cv::Mat certain = certainMask(filtered);
-  masked_share_ =
-      certain.empty() ? 0.0 : cv::countNonZero(certain) / static_cast<double>(certain.total());
   MotionFilterOutput widened = filtered;
   widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
   result.dynamic_matches = dropDynamic(matches, widened);
@@ -94,7 +90,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
 
   if (initialized_ && result.status != FrameStatus::kLost && !result.keyframe) {
     result.T_W_C = T_W_C;
-    if (needKeyframe(frame.timestamp_s, T_W_C)) {
+    // Held-back objects (a teddy taken for a person) are no movers: they do not count.
+    if (needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
       result.keyframe =
           createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask, widened.dynamic_mask);
     }

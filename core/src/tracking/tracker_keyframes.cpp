@@ -110,14 +110,15 @@ bool Tracker::Impl::relocalize(const RgbdFrame& frame, const cv::Mat& gray,
   return true;
 }
 
-bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const {
-  // Few tracks in a frame the movers fill mean nothing new to map: what is left unmasked is
-  // little and near the movers, and the tracks come back when they leave.
-  const bool crowded = masked_share_ > config_.kf_max_masked_share;
-  if (!crowded && static_cast<int>(tracks_.size()) < config_.min_tracked_features) return true;
-  if (!crowded && static_cast<double>(tracks_.size()) <
-                      config_.kf_min_tracked_ratio * static_cast<double>(ref_tracks_)) {
-    return true;
+bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                                 const cv::Mat& movers) const {
+  const auto n = static_cast<double>(tracks_.size());
+  if (n < config_.min_tracked_features || n < config_.kf_min_tracked_ratio * ref_tracks_) {
+    // Few tracks in a frame the movers fill mean nothing new to map: what is left unmasked is
+    // little and near the movers, and the tracks come back when they leave.
+    const double share =
+        movers.empty() ? 0.0 : cv::countNonZero(movers) / static_cast<double>(movers.total());
+    if (share <= config_.kf_max_masked_share) return true;
   }
   const Eigen::Isometry3d T_ref_C = ref_T_W_C_.inverse() * T_W_C;
   if (T_ref_C.translation().norm() > config_.kf_max_translation_m) return true;

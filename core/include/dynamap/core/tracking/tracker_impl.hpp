@@ -72,7 +72,9 @@ class Tracker::Impl {
   bool priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C);
   bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
                   Eigen::Isometry3d& T_W_C, int& inliers);
-  bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C) const;
+  /// `movers`: the frame's motion mask without held-back objects (kf_max_masked_share).
+  bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                    const cv::Mat& movers) const;
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
                                   const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
   /// New landmarks come from outside `track_mask`; the packet carries `dynamic_mask`.
@@ -108,7 +110,6 @@ class Tracker::Impl {
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
-  double masked_share_ = 0.0;  ///< share of this frame's image under its certainMask()
 
   std::uint64_t ref_kf_ = 0;
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
