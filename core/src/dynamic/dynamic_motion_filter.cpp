@@ -1,5 +1,7 @@
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 
+#include "dynamap/core/dynamic/support_planes.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -305,6 +307,23 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   if (!fused.unconfirmed.empty()) fused.unconfirmed.setTo(0, moved);
 }
 
+cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
+                                                const std::vector<Detection>& dets) {
+  if (config_.support_planes <= 0 || depth_m.empty() || mode_ == FusionMode::kDetector) return {};
+  const auto start = Clock::now();
+  cv::Mat exclude =
+      prev_mask_.empty() ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : prev_mask_.clone();
+  for (const auto& d : dets) {
+    const cv::Rect box = cv::Rect(d.box) & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
+    if (box.area() > 0) exclude(box).setTo(255);
+  }
+  SupportPlaneOptions o;
+  o.max_planes = config_.support_planes;
+  cv::Mat on_plane = planePixels(depth_m, K_, findSupportPlanes(depth_m, K_, exclude, o), o);
+  record("support_planes", msSince(start));
+  return on_plane;
+}
+
 MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   static const FeatureMatches kNoMatches;
   const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
@@ -331,6 +350,7 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   }
   epi.is_dynamic.resize(m.cur_px.size(), 0);
   record("epipolar", msSince(start));
+  evidence.planes = supportPlanePixels(frame_depth, dets);  // records its own time
 
   start = Clock::now();
   cv::Mat depth = frame_depth;

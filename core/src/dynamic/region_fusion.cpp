@@ -124,24 +124,32 @@ void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Poi
 }  // namespace
 
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
-                     double* depth_mode_m, double prior_depth_m) {
+                     double* depth_mode_m, double prior_depth_m, const cv::Mat& not_object) {
   if (depth_mode_m != nullptr) *depth_mode_m = 0.0;
   const cv::Rect box = box_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
   if (box.width < 4 || box.height < 4) return {};
-  const cv::Rect inner(box.x + box.width / 4, box.y + box.height * 15 / 100,
-                       std::max(1, box.width / 2), std::max(1, box.height * 70 / 100));
-  double mode = prior_depth_m > 0.0 ? depthMode(depth_m(inner), prior_depth_m) : 0.0;
-  if (mode <= 0.0) mode = depthMode(depth_m(inner), 0.0);
-  if (mode <= 0.0) return {};
+  const cv::Rect inner(box.width / 4, box.height * 15 / 100, std::max(1, box.width / 2),
+                       std::max(1, box.height * 70 / 100));  // in the box
+  cv::Mat z = depth_m(box);
+  if (!not_object.empty()) {
+    z = z.clone();
+    z.setTo(0.f, not_object(box));
+  }
+  double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
+  if (mode <= 0.0) mode = depthMode(z(inner), 0.0);
+  if (mode <= 0.0) {
+    const bool has_depth = !not_object.empty() && depthMode(depth_m(box)(inner), 0.0) > 0.0;
+    return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
+  }
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
-  cv::Mat sel = (depth_m(box) > mode - band_m) & (depth_m(box) < mode + band_m);
+  cv::Mat sel = (z > mode - band_m) & (z < mode + band_m);
   cv::morphologyEx(sel, sel, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  if (!not_object.empty()) sel.setTo(0, not_object(box));
   cv::Mat labels;
   const int n = cv::connectedComponents(sel, labels, 8, CV_32S);
   std::vector<int> votes(n, 0);
-  const cv::Rect inner_local = inner - box.tl();
-  for (int y = inner_local.y; y < inner_local.br().y; ++y) {
-    for (int x = inner_local.x; x < inner_local.br().x; ++x) ++votes[labels.at<int>(y, x)];
+  for (int y = inner.y; y < inner.br().y; ++y) {
+    for (int x = inner.x; x < inner.br().x; ++x) ++votes[labels.at<int>(y, x)];
   }
   votes[0] = 0;
   const int best = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
@@ -251,7 +259,8 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
                                    const std::vector<std::uint8_t>& dyn,
                                    const ObjectTrack* prev) const {
   const double prior = prev != nullptr ? prev->depth_m : 0.0;
-  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior);
+  cv::Mat region =
+      objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior, evidence_->planes);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);
@@ -439,6 +448,8 @@ int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Poi
     const cv::Rect roi = clampRect(cv::Rect2f(c.x - hw, c.y - hh, 2 * hw, 2 * hh), depth_m.size());
     cv::Mat flood = cv::Mat::zeros(roi.height + 2, roi.width + 2, CV_8UC1);
     flood(cv::Rect(1, 1, roi.width, roi.height)).setTo(1, claimed(roi));  // never grow into objects
+    if (!evidence_->planes.empty())
+      flood(cv::Rect(1, 1, roi.width, roi.height)).setTo(1, evidence_->planes(roi));
     const cv::Mat depth_roi = depth_m(roi).clone();
     const double step = config_.flood_depth_step_m;
     for (int i : group) {

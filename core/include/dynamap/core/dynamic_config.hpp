@@ -114,7 +114,11 @@ struct DynamicConfig {
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode
-  int mask_dilation_px = 3;   ///< final dilation of each region (mapping dilates again)
+  /// Up to this many large planes (floor, walls; found outside the objects each frame) are no
+  /// object's pixels: the floor at a walker's feet, a box carried by the flow onto the floor.
+  /// 0 = off.
+  int support_planes = 3;
+  int mask_dilation_px = 3;  ///< final dilation of each region (mapping dilates again)
   /// A moving object's pixels nearer (by more than 4 px) to a static tracked point inside it than
   /// to any dynamic one, and within this radius of it, are not masked: a standing person next to
   /// a walker at the same depth falls into the walker's depth cut. 0 = off.

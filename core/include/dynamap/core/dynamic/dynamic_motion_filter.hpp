@@ -71,6 +71,9 @@ class DynamicMotionFilter : public MotionFilter {
   /// The dense check (DynamicConfig::dense_check_frames): what the frame that many frames back
   /// saw through, outside fusion's objects, is added to the mask.
   void addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence, FusionResult& fused);
+  /// Pixels on the large planes of the frame (DynamicConfig::support_planes), found outside the
+  /// detections and the last mask; empty when off or without depth.
+  cv::Mat supportPlanePixels(const cv::Mat& depth_m, const std::vector<Detection>& dets);
   /// *background_fit: the camera motion was fitted on enough matches outside people and masks.
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets, const RigidMotion* prior,

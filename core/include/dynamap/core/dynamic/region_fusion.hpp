@@ -58,6 +58,9 @@ struct FusionEvidence {
   bool has_pose = false;
   cv::Matx44d T_W_C = cv::Matx44d::eye();
   cv::Vec4d K;
+  /// CV_8UC1 (empty: none), 255 = pixels on a large plane (floor, wall; findSupportPlanes): no
+  /// object's own. A box carried onto the floor, or the floor at a walker's feet, is not masked.
+  cv::Mat planes;
 };
 
 struct FusionResult {
@@ -73,9 +76,12 @@ struct FusionResult {
 
 /// The object's own pixels inside `box`: pixels within `band_m` of the dominant depth mode of
 /// the box centre, largest connected component, holes closed. Empty Mat if no depth.
-/// Returns a full-image CV_8UC1 mask (255 = object) and the mode in *depth_mode_m.
+/// Returns a full-image CV_8UC1 mask (255 = object) and the mode in *depth_mode_m. Pixels of
+/// `not_object` (CV_8UC1, may be empty) are never the object's; if the box holds depth but only
+/// there, the mask is all zero (an empty Mat still means: no depth).
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
-                     double* depth_mode_m, double prior_depth_m = 0.0);
+                     double* depth_mode_m, double prior_depth_m = 0.0,
+                     const cv::Mat& not_object = cv::Mat());
 
 /// Fuses dynamic points and detections into a motion mask, with per-object temporal state
 /// (objects are associated frame to frame by box IoU, boxes moved with the flow).

@@ -1,0 +1,130 @@
+#include "dynamap/core/dynamic/support_planes.hpp"
+
+#include "dynamap/core/dynamic/depth_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace dynamap {
+
+namespace {
+
+constexpr std::uint64_t kSeed = 0x5eed;
+constexpr double kMinNormal = 1e-9;
+
+double margin(double z_m, const SupportPlaneOptions& o) {
+  return std::clamp(o.noise_sigmas * depthNoiseM(z_m), o.min_margin_m, o.max_margin_m);
+}
+
+bool onPlane(const cv::Vec3d& p, const Plane& plane, const SupportPlaneOptions& o) {
+  return std::abs(plane.n.dot(p) + plane.d) <= margin(p[2], o);
+}
+
+/// The plane through three points (false if they are nearly collinear).
+bool planeThrough(const cv::Vec3d& a, const cv::Vec3d& b, const cv::Vec3d& c, Plane* plane) {
+  const cv::Vec3d n = (b - a).cross(c - a);
+  const double len = cv::norm(n);
+  if (len < kMinNormal) return false;
+  plane->n = n / len;
+  plane->d = -plane->n.dot(a);
+  return true;
+}
+
+/// Least-squares plane through `points` (their centroid and the direction of least spread).
+Plane refit(const std::vector<cv::Vec3d>& points) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += Eigen::Vector3d(p[0], p[1], p[2]);
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) {
+    const Eigen::Vector3d q = Eigen::Vector3d(p[0], p[1], p[2]) - mean;
+    cov += q * q.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::Vector3d n = eig.eigenvectors().col(0);
+  Plane plane;
+  plane.n = cv::Vec3d(n.x(), n.y(), n.z());
+  plane.d = -n.dot(mean);
+  return plane;
+}
+
+/// The best plane of `samples` by RANSAC, refitted to its inliers.
+Plane bestPlane(const std::vector<cv::Vec3d>& samples, const SupportPlaneOptions& o, cv::RNG& rng) {
+  Plane best;
+  const int n = static_cast<int>(samples.size());
+  for (int it = 0; it < o.iterations; ++it) {
+    Plane h;
+    if (!planeThrough(samples[rng.uniform(0, n)], samples[rng.uniform(0, n)],
+                      samples[rng.uniform(0, n)], &h)) {
+      continue;
+    }
+    h.inliers = static_cast<int>(std::count_if(samples.begin(), samples.end(),
+                                               [&](const auto& p) { return onPlane(p, h, o); }));
+    if (h.inliers > best.inliers) best = h;
+  }
+  if (best.inliers < 3) return best;
+  std::vector<cv::Vec3d> in;
+  for (const auto& p : samples) {
+    if (onPlane(p, best, o)) in.push_back(p);
+  }
+  Plane fitted = refit(in);
+  fitted.inliers = static_cast<int>(std::count_if(
+      samples.begin(), samples.end(), [&](const auto& p) { return onPlane(p, fitted, o); }));
+  return fitted.inliers >= best.inliers ? fitted : best;
+}
+
+}  // namespace
+
+std::vector<Plane> findSupportPlanes(const cv::Mat& depth_m, const cv::Vec4d& K,
+                                     const cv::Mat& exclude, const SupportPlaneOptions& o) {
+  std::vector<cv::Vec3d> samples;
+  const int step = std::max(1, o.stride_px);
+  for (int y = step / 2; y < depth_m.rows; y += step) {
+    for (int x = step / 2; x < depth_m.cols; x += step) {
+      const float z = depth_m.at<float>(y, x);
+      if (z <= 0.f || (!exclude.empty() && exclude.at<uchar>(y, x) != 0)) continue;
+      samples.emplace_back((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z);
+    }
+  }
+  const int needed =
+      std::max(o.min_inliers, static_cast<int>(std::ceil(o.min_share * samples.size())));
+  std::vector<Plane> planes;
+  cv::RNG rng(kSeed);
+  while (static_cast<int>(planes.size()) < o.max_planes &&
+         static_cast<int>(samples.size()) >= needed) {
+    const Plane plane = bestPlane(samples, o, rng);
+    if (plane.inliers < needed) break;
+    planes.push_back(plane);
+    samples.erase(std::remove_if(samples.begin(), samples.end(),
+                                 [&](const auto& p) { return onPlane(p, plane, o); }),
+                  samples.end());
+  }
+  return planes;
+}
+
+cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vector<Plane>& planes,
+                    const SupportPlaneOptions& o) {
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  if (planes.empty()) return out;
+  for (int y = 0; y < depth_m.rows; ++y) {
+    const float* z_row = depth_m.ptr<float>(y);
+    uchar* out_row = out.ptr<uchar>(y);
+    const double ry = (y - K[3]) / K[1];
+    for (int x = 0; x < depth_m.cols; ++x) {
+      const double z = z_row[x];
+      if (z <= 0.0) continue;
+      const cv::Vec3d p((x - K[2]) / K[0] * z, ry * z, z);
+      for (const auto& plane : planes) {
+        if (onPlane(p, plane, o)) {
+          out_row[x] = 255;
+          break;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace dynamap
