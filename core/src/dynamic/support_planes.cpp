@@ -14,12 +14,24 @@ namespace {
 constexpr std::uint64_t kSeed = 0x5eed;
 constexpr double kMinNormal = 1e-9;
 
-double margin(double z_m, const SupportPlaneOptions& o) {
-  return std::clamp(o.noise_sigmas * depthNoiseM(z_m), o.min_margin_m, o.max_margin_m);
+/// A point and how far off a plane it may lie and still be on it (the noise at its depth).
+struct Sample {
+  cv::Vec3d p;
+  double margin_m;
+};
+
+Sample sample(double x, double y, double z, const cv::Vec4d& K, const SupportPlaneOptions& o) {
+  return {cv::Vec3d((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z),
+          std::clamp(o.noise_sigmas * depthNoiseM(z), o.min_margin_m, o.max_margin_m)};
 }
 
-bool onPlane(const cv::Vec3d& p, const Plane& plane, const SupportPlaneOptions& o) {
-  return std::abs(plane.n.dot(p) + plane.d) <= margin(p[2], o);
+bool onPlane(const Sample& s, const Plane& plane) {
+  return std::abs(plane.n.dot(s.p) + plane.d) <= s.margin_m;
+}
+
+int countOn(const std::vector<Sample>& samples, const Plane& plane) {
+  return static_cast<int>(std::count_if(samples.begin(), samples.end(),
+                                        [&](const Sample& s) { return onPlane(s, plane); }));
 }
 
 /// The plane through three points (false if they are nearly collinear).
@@ -51,27 +63,25 @@ Plane refit(const std::vector<cv::Vec3d>& points) {
 }
 
 /// The best plane of `samples` by RANSAC, refitted to its inliers.
-Plane bestPlane(const std::vector<cv::Vec3d>& samples, const SupportPlaneOptions& o, cv::RNG& rng) {
+Plane bestPlane(const std::vector<Sample>& samples, const SupportPlaneOptions& o, cv::RNG& rng) {
   Plane best;
   const int n = static_cast<int>(samples.size());
   for (int it = 0; it < o.iterations; ++it) {
     Plane h;
-    if (!planeThrough(samples[rng.uniform(0, n)], samples[rng.uniform(0, n)],
-                      samples[rng.uniform(0, n)], &h)) {
+    if (!planeThrough(samples[rng.uniform(0, n)].p, samples[rng.uniform(0, n)].p,
+                      samples[rng.uniform(0, n)].p, &h)) {
       continue;
     }
-    h.inliers = static_cast<int>(std::count_if(samples.begin(), samples.end(),
-                                               [&](const auto& p) { return onPlane(p, h, o); }));
+    h.inliers = countOn(samples, h);
     if (h.inliers > best.inliers) best = h;
   }
   if (best.inliers < 3) return best;
   std::vector<cv::Vec3d> in;
-  for (const auto& p : samples) {
-    if (onPlane(p, best, o)) in.push_back(p);
+  for (const auto& s : samples) {
+    if (onPlane(s, best)) in.push_back(s.p);
   }
   Plane fitted = refit(in);
-  fitted.inliers = static_cast<int>(std::count_if(
-      samples.begin(), samples.end(), [&](const auto& p) { return onPlane(p, fitted, o); }));
+  fitted.inliers = countOn(samples, fitted);
   return fitted.inliers >= best.inliers ? fitted : best;
 }
 
@@ -79,13 +89,13 @@ Plane bestPlane(const std::vector<cv::Vec3d>& samples, const SupportPlaneOptions
 
 std::vector<Plane> findSupportPlanes(const cv::Mat& depth_m, const cv::Vec4d& K,
                                      const cv::Mat& exclude, const SupportPlaneOptions& o) {
-  std::vector<cv::Vec3d> samples;
+  std::vector<Sample> samples;
   const int step = std::max(1, o.stride_px);
   for (int y = step / 2; y < depth_m.rows; y += step) {
     for (int x = step / 2; x < depth_m.cols; x += step) {
       const float z = depth_m.at<float>(y, x);
       if (z <= 0.f || (!exclude.empty() && exclude.at<uchar>(y, x) != 0)) continue;
-      samples.emplace_back((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z);
+      samples.push_back(sample(x, y, z, K, o));
     }
   }
   const int needed =
@@ -98,7 +108,7 @@ std::vector<Plane> findSupportPlanes(const cv::Mat& depth_m, const cv::Vec4d& K,
     if (plane.inliers < needed) break;
     planes.push_back(plane);
     samples.erase(std::remove_if(samples.begin(), samples.end(),
-                                 [&](const auto& p) { return onPlane(p, plane, o); }),
+                                 [&](const Sample& s) { return onPlane(s, plane); }),
                   samples.end());
   }
   return planes;
@@ -111,13 +121,11 @@ cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vecto
   for (int y = 0; y < depth_m.rows; ++y) {
     const float* z_row = depth_m.ptr<float>(y);
     uchar* out_row = out.ptr<uchar>(y);
-    const double ry = (y - K[3]) / K[1];
     for (int x = 0; x < depth_m.cols; ++x) {
-      const double z = z_row[x];
-      if (z <= 0.0) continue;
-      const cv::Vec3d p((x - K[2]) / K[0] * z, ry * z, z);
+      if (z_row[x] <= 0.f) continue;
+      const Sample s = sample(x, y, z_row[x], K, o);
       for (const auto& plane : planes) {
-        if (onPlane(p, plane, o)) {
+        if (onPlane(s, plane)) {
           out_row[x] = 255;
           break;
         }
