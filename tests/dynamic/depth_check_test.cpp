@@ -54,6 +54,26 @@ TEST(DepthCheck, SensorNoiseGrowsWithTheSquareOfDepth) {
   EXPECT_NEAR(depthNoiseM(3.4), 0.0012 + 0.0019 * 9.0, 1e-9);
 }
 
+TEST(DepthCheck, WindowInteriorDepthRejectsPointsWhoseWindowTakesInAnOccludingEdge) {
+  // A person 2 m away, a crate 1 m away covering x >= 320, a hole at (100, 100).
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.f));
+  depth(cv::Rect(320, 0, 320, 480)).setTo(1.f);
+  depth.at<float>(100, 100) = 0.f;
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 200, 240, 8, 0.1f), 2.f);
+  // 6 px from the crate: interiorDepth() (4 px) takes it, an 8 px window does not.
+  EXPECT_FLOAT_EQ(interiorDepth(depth, 314, 240), 2.f);
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 314, 240, 8, 0.1f), 0.f);
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 311, 240, 8, 0.1f), 2.f);  // 9 px away
+  // The crate's side of the edge, a diagonal neighbour in a hole, the image border.
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 326, 240, 8, 0.1f), 0.f);
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 108, 108, 8, 0.1f), 0.f);
+  EXPECT_FLOAT_EQ(windowInteriorDepth(depth, 5, 240, 8, 0.1f), 0.f);
+  // A gentle slope (a floor) is no edge.
+  cv::Mat slope(480, 640, CV_32F);
+  for (int y = 0; y < 480; ++y) slope.row(y).setTo(1.f + 0.004f * y);
+  EXPECT_GT(windowInteriorDepth(slope, 320, 240, 8, 0.1f), 0.f);
+}
+
 TEST(DepthCheck, AStillRoomAgreesWithAnEarlierViewAndNothingIsSeenThrough) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 7);

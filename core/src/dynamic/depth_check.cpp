@@ -65,6 +65,20 @@ float interiorDepth(const cv::Mat& depth_m, int x, int y) {
   return z;
 }
 
+float windowInteriorDepth(const cv::Mat& depth_m, int x, int y, int radius_px, float step_m) {
+  const float z = interiorDepth(depth_m, x, y);
+  if (z <= 0.f) return 0.f;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int u = x + dx * radius_px, v = y + dy * radius_px;
+      if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) return 0.f;
+      const float n = depth_m.at<float>(v, u);
+      if (n <= 0.f || std::abs(n - z) > step_m) return 0.f;
+    }
+  }
+  return z;
+}
+
 double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
 
 DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi,

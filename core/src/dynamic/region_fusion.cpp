@@ -13,9 +13,13 @@ namespace dynamap {
 namespace {
 
 constexpr double kBinM = 0.1;
-constexpr int kStaticMinPoints = 5;     ///< points needed on an object to call it static now
-constexpr int kAnchorMinPoints = 3;     ///< anchored points needed for the anchor test
-constexpr int kMaxSlowDoublings = 4;    ///< ObjectTrack::slow_moves: at most 16 x the frames
+constexpr int kStaticMinPoints = 5;   ///< points needed on an object to call it static now
+constexpr int kAnchorMinPoints = 3;   ///< anchored points needed for the anchor test
+constexpr int kMaxSlowDoublings = 4;  ///< ObjectTrack::slow_moves: at most 16 x the frames
+/// An anchored point's surface must be continuous this far around it (an LK window of 15 px and
+/// then some; windowInteriorDepth()) ...
+constexpr int kAnchorWindowPx = 8;
+constexpr float kAnchorWindowM = 0.1f;  ///< ... within this depth step
 constexpr int kBins = 100;              // 0..10 m
 constexpr float kMatchIou = 0.3f;       ///< a detection continues a track above this IoU
 constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelPerObject)
@@ -284,7 +288,8 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
     if (dyn[i]) ++d.dynamic_points;
     if (with_ids) {
       samples.push_back({evidence_->point_ids[i], points[i],
-                         interiorDepth(depth_m, cvRound(points[i].x), cvRound(points[i].y))});
+                         windowInteriorDepth(depth_m, cvRound(points[i].x), cvRound(points[i].y),
+                                             kAnchorWindowPx, kAnchorWindowM)});
     }
   }
   if (with_ids) {

@@ -49,6 +49,12 @@ double depthNoiseM(double z_m);
 /// slides along it as the camera moves and is no fixed point of the surface.
 float interiorDepth(const cv::Mat& depth_m, int x, int y);
 
+/// Depth at (x, y) unless, besides interiorDepth()'s test, one of the 8 neighbours `radius_px`
+/// away (the corners of the square around it) is outside the image, has no depth or differs by
+/// more than `step_m`; else 0. A tracked feature whose window takes in an occluding edge follows
+/// that edge, not the surface under it.
+float windowInteriorDepth(const cv::Mat& depth_m, int x, int y, int radius_px, float step_m);
+
 /// Compares the sampled pixels of `region` (CV_8UC1, 255 = in; only inside `roi`) of the current
 /// depth (pose T_W_C, intrinsics K = fx, fy, cx, cy) with `view`. Pixels on depth edges (a
 /// neighbour 4 px away differs by more than 0.1 m) are not sampled. With `seen_through` (a
