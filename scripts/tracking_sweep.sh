@@ -6,7 +6,7 @@
 # and the real Bonn crowd slice (its own camera: config/bonn.yaml). For the semi-synthetic
 # sequences (ground-truth masks and reference clouds) the means of the keyframe-mask and map
 # metrics over the variants follow: the masks' IoU, pixel recall and precision, the share of the
-# standing person masked, the map's precision and ghost ratio.
+# standing person masked, the map's precision, completeness, ghost ratio and ghost fragments.
 # Offline runs are deterministic, but any change to tracking moves a single run's ATE by up to
 # ~0.3 cm (several cm on Bonn); the variants show whether a change helps in general.
 # usage: scripts/tracking_sweep.sh [--set key=value ...]   (12 variants; ~6 minutes on 2 cores)
@@ -74,7 +74,8 @@ import glob, json, sys
 out, names = sys.argv[1], sys.argv[2:]
 keys = [("masks", "mean_iou", "IoU"), ("masks", "pixel_recall", "recall"),
         ("masks", "pixel_precision", "precision"), ("masks", "standing_masked_share", "standing"),
-        ("map", "precision", "map_prec"), ("map", "ghost_ratio", "ghost_%")]
+        ("map", "precision", "map_prec"), ("map", "completeness", "map_comp"),
+        ("map", "ghost_ratio", "ghost_%"), ("map", "ghost_fragments", "fragments")]
 print("%-6s %3s" % ("masks", "n") + "".join(" %9s" % k[2] for k in keys))
 for name in names:
     rows = []

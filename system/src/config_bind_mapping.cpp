@@ -11,6 +11,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addInt("mapping.mask_dilation_px", &s.mask_dilation_px, 0, 100);
   schema.addDouble("mapping.depth_edge_threshold_m", &s.depth_edge_threshold_m, 0.0, 100.0);
   schema.addInt("mapping.stride", &s.stride, 1, 64);
+  schema.addInt("mapping.mask_lookahead_frames", &c.mask_lookahead_frames, 0, 30);
   schema.addBool("mapping.free_space_check", &s.free_space.enabled);
   schema.addInt("mapping.free_space_neighbours", &s.free_space.neighbours, 1, 20);
   schema.addDouble("mapping.free_space_margin_m", &s.free_space.margin_m, 0.0, 10.0);

@@ -2,11 +2,13 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "dynamap/mapping/backend_registry.hpp"
 #include "dynamap/mapping/mapping_worker.hpp"
+#include "dynamap/mapping/mask_lookahead.hpp"
 #include "frame_input.hpp"
 #include "plugin_paths.hpp"
 
@@ -25,8 +27,18 @@ struct System::Impl {
   SystemCounts counts;
   std::vector<TimedPose> given_trajectory;  // given poses only
   bool finished = false;
+  // Mask look-ahead: the last keyframe waits for the masks of the next frames.
+  int lookahead_frames = 0;
+  std::shared_ptr<KeyframePacket> pending;
+  int pending_seen = 0;
+  std::vector<KeyframePacketPtr> last_mapped;  // released by finish()
 
   void pushKeyframe(KeyframePacketPtr kf);
+  /// Adds what `frame`'s mask covers to the waiting keyframe's mask; hands it to the mapper
+  /// once lookahead_frames frames have been seen.
+  void lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
+                 std::vector<KeyframePacketPtr>& mapped);
+  void releasePending(std::vector<KeyframePacketPtr>& mapped);
 };
 
 void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
@@ -35,6 +47,39 @@ void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
   } else if (!mapper->tryPush(std::move(kf))) {
     ++counts.mapper_dropped;
   }
+}
+
+void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
+                             std::vector<KeyframePacketPtr>& mapped) {
+  if (!pending) return;
+  if (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized) {
+    ScopedStageTimer timer(timings, "mask_lookahead");
+    // Only what the later frame saw moving: a person masked there for lack of evidence that
+    // they stand still (held back) is no evidence against the keyframe's pixels.
+    cv::Mat moving = tracked.dynamic_mask;
+    if (!moving.empty() && !tracked.unconfirmed_mask.empty()) {
+      moving = moving.clone();
+      moving.setTo(0, tracked.unconfirmed_mask);
+    }
+    const cv::Mat later = maskSeenLater(camera, pending->depth_m, pending->T_W_C, frame.depth_m,
+                                        tracked.T_W_C, moving);
+    if (cv::countNonZero(later) > 0) {
+      if (pending->dynamic_mask.empty()) {
+        pending->dynamic_mask = later;
+      } else {
+        cv::bitwise_or(pending->dynamic_mask, later, pending->dynamic_mask);
+      }
+    }
+  }
+  if (++pending_seen >= lookahead_frames) releasePending(mapped);
+}
+
+void System::Impl::releasePending(std::vector<KeyframePacketPtr>& mapped) {
+  if (!pending) return;
+  KeyframePacketPtr kf = std::move(pending);
+  pending.reset();
+  mapped.push_back(kf);
+  pushKeyframe(std::move(kf));
 }
 
 namespace {
@@ -50,6 +95,7 @@ System::System(const AppConfig& config, SystemOptions options) : impl_(std::make
   s.options = std::move(options);
   if (s.options.timings != nullptr) s.timings = s.options.timings;
   s.camera = config.resolvedCamera();
+  s.lookahead_frames = config.mapping.mask_lookahead_frames;
   s.input = FrameInput(s.camera, config.camera.depth_scale);
 
   // Mapping backend first: an unknown backend or a bad parameter is an error before any work.
@@ -98,10 +144,19 @@ TrackOutput System::track(const RgbdFrame& frame) {
   out.status = tracked.status;
   out.T_W_C = tracked.T_W_C;
   out.dynamic_mask = maskOrZeros(tracked.dynamic_mask, frame.bgr.size());
+  s.lookAhead(frame, tracked, out.mapped);
   if (tracked.is_keyframe && tracked.keyframe) {
     out.is_keyframe = true;
     out.keyframe = tracked.keyframe;
-    s.pushKeyframe(tracked.keyframe);
+    s.releasePending(out.mapped);
+    if (s.lookahead_frames > 0) {
+      s.pending = std::make_shared<KeyframePacket>(*tracked.keyframe);
+      s.pending->dynamic_mask = tracked.keyframe->dynamic_mask.clone();
+      s.pending_seen = 0;
+    } else {
+      out.mapped.push_back(tracked.keyframe);
+      s.pushKeyframe(tracked.keyframe);
+    }
   }
   const auto updates = s.tracker->takePoseUpdates();
   if (!updates.empty()) s.mapper->applyPoseUpdates(updates);
@@ -132,6 +187,7 @@ TrackOutput System::mapWithPose(const RgbdFrame& frame, const Eigen::Isometry3d&
   ++s.counts.keyframes;
   s.pushKeyframe(kf);
   TrackOutput out;
+  out.mapped.push_back(kf);
   out.status = FrameStatus::kTracked;
   out.T_W_C = T_W_C;
   out.dynamic_mask = maskOrZeros(mask, frame.bgr.size());
@@ -181,6 +237,7 @@ void System::finish() {
   auto& s = *impl_;
   if (s.finished) return;
   s.finished = true;
+  s.releasePending(s.last_mapped);
   if (s.tracker) {
     s.tracker->finish();
     std::vector<PoseUpdate> final_poses;
@@ -188,6 +245,11 @@ void System::finish() {
     s.mapper->applyPoseUpdates(final_poses);
   }
   s.mapper->finish();
+}
+
+std::vector<KeyframePacketPtr> System::takeLastMapped() {
+  finish();
+  return std::exchange(impl_->last_mapped, {});
 }
 
 void System::exportMap(const std::string& dir) {

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "dynamap/system/config_schema.hpp"
 #include "test_paths.hpp"
 
@@ -63,6 +65,70 @@ TEST(System, TracksAFrameAndReturnsAFrameSizedMask) {
   EXPECT_FALSE(timings.allStats().empty());
   system.finish();
   EXPECT_THROW(system.track(bgr, depth, 13.0), std::logic_error);
+}
+
+/// Masks a fixed rectangle from the frame with index `from` on: a mover found late.
+class LateMaskFilter : public MotionFilter {
+ public:
+  LateMaskFilter(cv::Rect rect, std::size_t from) : rect_(rect), from_(from) {}
+  void beginFrame(const RgbdFrame& frame) override {
+    mask_ = cv::Mat::zeros(frame.bgr.size(), CV_8UC1);
+    if (frame.index >= from_) mask_(rect_).setTo(255);
+  }
+  MotionFilterOutput filter(const MotionFilterInput& input) override {
+    MotionFilterOutput out;
+    out.dynamic_mask = mask_;
+    for (const auto& p : input.matches->cur_px) out.match_is_dynamic.push_back(rect_.contains(p));
+    return out;
+  }
+
+ private:
+  cv::Rect rect_;
+  std::size_t from_;
+  cv::Mat mask_;
+};
+
+TEST(System, AKeyframeWaitsForTheMasksOfTheNextFrames) {
+  const cv::Rect mover(200, 150, 120, 200);
+  cv::Mat bgr(480, 640, CV_8UC3);
+  cv::theRNG().state = 7;
+  cv::randu(bgr, 0, 255);
+  cv::GaussianBlur(bgr, bgr, {5, 5}, 1.0);  // texture that LK can follow
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar::all(2.0));
+  for (const int lookahead : {0, 2}) {
+    AppConfig config = fastConfig();
+    config.mapping.mask_lookahead_frames = lookahead;
+    SystemOptions options;
+    options.motion_filter = std::make_unique<LateMaskFilter>(mover, 1);
+    System system(config, std::move(options));
+    std::vector<KeyframePacketPtr> mapped;
+    for (int i = 0; i < 4; ++i) {
+      const TrackOutput out = system.track(bgr, depth, 0.033 * i);
+      if (i == 0) {  // the map's first keyframe: no motion evidence, nothing masked
+        ASSERT_TRUE(out.is_keyframe);
+        EXPECT_EQ(cv::countNonZero(out.keyframe->dynamic_mask), 0);
+      }
+      mapped.insert(mapped.end(), out.mapped.begin(), out.mapped.end());
+      if (lookahead == 0 && i == 0) {
+        EXPECT_EQ(out.mapped.size(), 1u);
+      }
+      if (lookahead == 2 && i < 2) {
+        EXPECT_TRUE(out.mapped.empty()) << "frame " << i;
+      }
+    }
+    for (const auto& kf : system.takeLastMapped()) mapped.push_back(kf);
+    EXPECT_TRUE(system.takeLastMapped().empty());
+    ASSERT_FALSE(mapped.empty());
+    ASSERT_EQ(mapped.front()->id, 0u);
+    const cv::Mat& mask = mapped.front()->dynamic_mask;
+    const int in_rect = mask.empty() ? 0 : cv::countNonZero(mask(mover));
+    if (lookahead == 0) {
+      EXPECT_EQ(in_rect, 0);
+    } else {  // frames 1 and 2 masked the mover: keyframe 0 is masked there, and only there
+      EXPECT_GT(in_rect, 0.98 * mover.area());
+      EXPECT_EQ(cv::countNonZero(mask) - in_rect, 0);
+    }
+  }
 }
 
 TEST(System, GivenPosesMapEveryFrameAsAKeyframe) {

@@ -176,18 +176,31 @@ void Pipeline::processFrame(std::size_t index, RunResult& result) {
   const TrackOutput tracked = s.system->track(frame);
   if (options_.debug_images) logObjects(entry);
   if (tracked.is_keyframe) {
-    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, *tracked.keyframe, result);
-    if (options_.save_masks) writeKeyframeMask(entry, *tracked.keyframe);
+    keyframe_entry_[tracked.keyframe->id] = index;
+    if (!gt_masks_dir_.empty())
+      scoreKeyframeMask(entry, *tracked.keyframe, result.tracker_mask_scores);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
+  }
+  mappedKeyframes(tracked.mapped, result);
+}
+
+void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped, RunResult& result) {
+  for (const KeyframePacketPtr& kf : mapped) {
+    const auto it = keyframe_entry_.find(kf->id);
+    if (it == keyframe_entry_.end()) continue;
+    const SequenceEntry& entry = sequence_.entries()[it->second];
+    keyframe_entry_.erase(it);
+    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, *kf, result.mask_scores);
+    if (options_.save_masks) writeKeyframeMask(entry, *kf);
   }
 }
 
 void Pipeline::scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
-                                 RunResult& result) const {
+                                 MaskScoreSummary& scores) const {
   const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
   const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (gt.empty() || gt.size() != keyframe.bgr.size()) return;  // no usable truth
-  result.mask_scores.add(scoreMask(keyframe.dynamic_mask, gt));
+  scores.add(scoreMask(keyframe.dynamic_mask, gt));
 }
 
 void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const {
@@ -225,6 +238,7 @@ void Pipeline::logObjects(const SequenceEntry& entry) {
 void Pipeline::finalize(RunResult& result) {
   System& system = *stages_->system;
   system.finish();
+  mappedKeyframes(system.takeLastMapped(), result);
   const auto trajectory = system.trajectory();
   const auto statuses = system.frameStatuses();
   const bool given = stages_->given_poses != nullptr;

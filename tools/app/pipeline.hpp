@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "dynamap/core/frame.hpp"
@@ -41,8 +42,10 @@ struct RunResult {
   std::string backend;
   std::string mode = "offline";  ///< offline | realtime
   std::string map_dir;
-  /// Keyframe masks vs the sequence's ground-truth masks (DIR/mask/), when it has them.
+  /// Keyframe masks vs the sequence's ground-truth masks (DIR/mask/), when it has them: the
+  /// masks the map used (after mapping.mask_lookahead_frames), and the tracker's own.
   MaskScoreSummary mask_scores;
+  MaskScoreSummary tracker_mask_scores;
 };
 
 /// The run: frames -> tracking (with motion-area removal) -> keyframes -> mapping.
@@ -65,8 +68,10 @@ class Pipeline {
   void processFrames(RunResult& result);
   void processFrame(std::size_t index, RunResult& result);
   void finalize(RunResult& result);
+  /// Scores (and with --save-masks writes) the masks of keyframes handed to the mapper.
+  void mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped, RunResult& result);
   void scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
-                         RunResult& result) const;
+                         MaskScoreSummary& scores) const;
   void writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
                        const TrackOutput& tracked) const;
@@ -80,6 +85,7 @@ class Pipeline {
   std::unique_ptr<Stages> stages_;
   std::string gt_masks_dir_;  ///< sequence_dir/mask when present
   bool object_log_started_ = false;
+  std::unordered_map<std::uint64_t, std::size_t> keyframe_entry_;  ///< keyframe id -> entry
 };
 
 }  // namespace dynamap

@@ -114,6 +114,7 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
   }
   if (result.mask_scores.frames() > 0) {
     metrics["masks"] = Json::parse(result.mask_scores.toJson());
+    metrics["tracker_masks"] = Json::parse(result.tracker_mask_scores.toJson());
   }
   if (!metrics.empty()) {
     writeTextFileAtomic(outPath(options, "metrics.json"), dumpJson(metrics) + "\n");
@@ -140,6 +141,7 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
   if (!report.map_metrics_json.empty()) out << "map: " << report.map_metrics_json << "\n";
   if (result.mask_scores.frames() > 0) {
     out << "keyframe masks vs ground truth: " << result.mask_scores.toJson() << "\n";
+    out << "  (the tracker's own: " << result.tracker_mask_scores.toJson() << ")\n";
   }
   out << report.warnings;
   out << "outputs in " << options.out_dir << " (map: " << result.map_dir

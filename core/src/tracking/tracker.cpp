@@ -56,6 +56,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   const MotionFilterOutput filtered =
       runMotionFilter(frame, gray, matches, has_prior ? &T_W_C_prior : nullptr);
   result.dynamic_mask = filtered.dynamic_mask;
+  result.unconfirmed_mask = filtered.unconfirmed_mask;
   MotionFilterOutput widened = filtered;
   widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
   result.dynamic_matches = dropDynamic(matches, widened);

@@ -23,7 +23,11 @@ struct TrackOutput {
   /// CV_8UC1, frame-sized, 255 = moving (all zeros when nothing moves or no filter runs).
   cv::Mat dynamic_mask;
   bool is_keyframe = false;
-  KeyframePacketPtr keyframe;  ///< set iff is_keyframe (what the mapper received)
+  KeyframePacketPtr keyframe;  ///< set iff is_keyframe (as the tracker made it)
+  /// Keyframes handed to the mapper in this call, with the masks the map used: a keyframe waits
+  /// mapping.mask_lookahead_frames frames for later masks (0: a keyframe is mapped at once and
+  /// is its own entry here). See System::takeLastMapped() for the one finish() hands over.
+  std::vector<KeyframePacketPtr> mapped;
 };
 
 /// Frame and keyframe counts so far.
@@ -106,6 +110,9 @@ class System {
   /// Final bundle adjustment, final keyframe poses to the mapper, waits for mapping and stops
   /// the worker threads. Idempotent; track() throws std::logic_error afterwards.
   void finish();
+  /// The keyframe finish() handed to the mapper (the one still waiting for later masks), once;
+  /// empty if none. Thread-safe as finish().
+  std::vector<KeyframePacketPtr> takeLastMapped();
   /// finish(), then writes the backend's map files into `dir` (created if needed).
   void exportMap(const std::string& dir);
 

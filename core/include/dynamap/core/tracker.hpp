@@ -26,6 +26,9 @@ struct TrackingResult {
   int inliers = 0;             ///< pose inliers
   int dynamic_matches = 0;     ///< matches the motion filter rejected
   cv::Mat dynamic_mask;        ///< from the motion filter, may be empty
+  /// Of dynamic_mask, the pixels masked only for lack of evidence that they stand still
+  /// (MotionFilterOutput::unconfirmed_mask); may be empty.
+  cv::Mat unconfirmed_mask;
 };
 
 /// Counters over all frames. frames = tracked + relocalized + lost + bad_frames.

@@ -16,6 +16,10 @@ struct MappingConfig {
   /// Depth + dynamic mask -> static points ("mapping.depth_min_m", "mapping.mask_dilation_px",
   /// ...).
   StaticPointsOptions static_points;
+  /// A keyframe waits for this many frames; whatever their dynamic masks cover of its surfaces
+  /// is masked in it too (maskSeenLater): a person the detector finds a moment later was there
+  /// already. 0 = a keyframe goes to the mapper at once.
+  int mask_lookahead_frames = 2;
 };
 
 }  // namespace dynamap

@@ -1,0 +1,45 @@
+#include "dynamap/mapping/mask_lookahead.hpp"
+
+#include <cmath>
+#include <cstdint>
+
+namespace dynamap {
+
+cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
+                      const Eigen::Isometry3d& T_W_K, const cv::Mat& later_depth_m,
+                      const Eigen::Isometry3d& T_W_L, const cv::Mat& later_mask,
+                      double occluder_margin_m) {
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  if (depth_m.empty() || later_mask.empty() || later_mask.size() != later_depth_m.size() ||
+      cv::countNonZero(later_mask) == 0) {
+    return out;
+  }
+  const Eigen::Isometry3f T_L_K = (T_W_L.inverse() * T_W_K).cast<float>();
+  const Eigen::Matrix3f R = T_L_K.linear();
+  const Eigen::Vector3f t = T_L_K.translation();
+  const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const auto margin = static_cast<float>(occluder_margin_m);
+  const int w = later_mask.cols, h = later_mask.rows;
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const float* z_row = depth_m.ptr<float>(v);
+    std::uint8_t* out_row = out.ptr<std::uint8_t>(v);
+    const float y_n = (static_cast<float>(v) - cy) / fy;
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const float z = z_row[u];
+      if (!(z > 0.0f)) continue;
+      const Eigen::Vector3f p =
+          R * Eigen::Vector3f((static_cast<float>(u) - cx) / fx * z, y_n * z, z) + t;
+      if (p.z() <= 0.1f) continue;
+      const int ul = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
+      const int vl = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
+      if (ul < 0 || vl < 0 || ul >= w || vl >= h) continue;
+      if (later_mask.at<std::uint8_t>(vl, ul) == 0) continue;
+      const float seen = later_depth_m.at<float>(vl, ul);
+      if (seen > 0.0f && seen >= p.z() - margin) out_row[u] = 255;
+    }
+  }
+  return out;
+}
+
+}  // namespace dynamap

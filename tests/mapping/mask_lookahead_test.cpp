@@ -1,0 +1,73 @@
+// maskSeenLater (mask_lookahead.hpp): a later frame's mask, carried back into a keyframe through
+// the keyframe's depth and both poses. Analytic scene: a wall 3 m away, a person (a board) 1.5 m
+// away; between the keyframe and the later frame the camera moves 5 cm sideways and the person
+// 3 cm, and a second mover steps in front of the wall.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "dynamap/mapping/mask_lookahead.hpp"
+
+namespace dynamap {
+namespace {
+
+struct Board {
+  double x0, x1, y0, y1, z;  ///< world rectangle at depth z (camera looks along +z)
+};
+
+/// Depth (and mask of `masked` boards) of a camera at `T_W_C` (translation only).
+void render(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+            const std::vector<Board>& boards, const std::vector<bool>& masked, cv::Mat* depth_m,
+            cv::Mat* mask) {
+  *depth_m = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(3.0f));  // the wall
+  *mask = cv::Mat::zeros(camera.height, camera.width, CV_8UC1);
+  const Eigen::Vector3d c = T_W_C.translation();
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const Eigen::Vector3d ray = camera.backProject(u, v, 1.0);
+      for (std::size_t b = 0; b < boards.size(); ++b) {
+        const double s = boards[b].z - c.z();
+        const Eigen::Vector3d p = c + s * ray;
+        if (p.x() < boards[b].x0 || p.x() > boards[b].x1 || p.y() < boards[b].y0 ||
+            p.y() > boards[b].y1 || s >= depth_m->at<float>(v, u)) {
+          continue;
+        }
+        depth_m->at<float>(v, u) = static_cast<float>(s);
+        mask->at<std::uint8_t>(v, u) = masked[b] ? 255 : 0;
+      }
+    }
+  }
+}
+
+TEST(MaskLookahead, MarksTheMoverALaterMaskCoversAndNotWhatMovedInFrontLater) {
+  PinholeCamera camera;
+  const Board person{-0.2, 0.1, -0.5, 0.6, 1.5};
+  const Board newcomer{0.5, 0.8, -0.3, 0.5, 1.0};  // only in the later frame
+  Eigen::Isometry3d T_W_K = Eigen::Isometry3d::Identity(), T_W_L = T_W_K;
+  T_W_L.translation() = Eigen::Vector3d(0.05, 0.0, 0.0);
+  cv::Mat depth_k, mask_k, depth_l, mask_l;
+  render(camera, T_W_K, {person}, {true}, &depth_k, &mask_k);  // mask_k: the truth
+  Board moved = person;
+  moved.x0 += 0.03;
+  moved.x1 += 0.03;
+  render(camera, T_W_L, {moved, newcomer}, {true, true}, &depth_l, &mask_l);
+
+  const cv::Mat marked = maskSeenLater(camera, depth_k, T_W_K, depth_l, T_W_L, mask_l);
+  ASSERT_EQ(marked.size(), depth_k.size());
+  const double person_px = cv::countNonZero(mask_k);
+  const double wall_px = static_cast<double>(mask_k.total()) - person_px;
+  // The person moved 3 cm (about 11 px at 1.5 m): all but that sliver is marked.
+  EXPECT_GT(cv::countNonZero(marked & mask_k) / person_px, 0.85);
+  // The wall the newcomer hides later, and the wall the person moved over, are not.
+  EXPECT_LT(cv::countNonZero(marked & ~mask_k) / wall_px, 0.002);
+
+  // Without a later mask nothing is marked; an empty keyframe depth marks nothing either.
+  EXPECT_EQ(cv::countNonZero(maskSeenLater(camera, depth_k, T_W_K, depth_l, T_W_L,
+                                           cv::Mat::zeros(mask_l.size(), CV_8UC1))),
+            0);
+  const cv::Mat no_depth = cv::Mat::zeros(depth_k.size(), CV_32FC1);
+  EXPECT_EQ(cv::countNonZero(maskSeenLater(camera, no_depth, T_W_K, depth_l, T_W_L, mask_l)), 0);
+}
+
+}  // namespace
+}  // namespace dynamap
