@@ -9,10 +9,17 @@
 # standing person masked, the map's precision, completeness, ghost ratio and ghost fragments.
 # Offline runs are deterministic, but any change to tracking moves a single run's ATE by up to
 # ~0.3 cm (several cm on Bonn); the variants show whether a change helps in general.
-# usage: scripts/tracking_sweep.sh [--set key=value ...]   (12 variants; ~6 minutes on 2 cores)
+# usage: scripts/tracking_sweep.sh [--set key=value ...]   (12 variants; ~12 minutes on 2 cores)
+# BIN=DIR/bin/dynamap runs a frozen copy of a build (bin/ and lib/ copied side by side), so that
+# rebuilding the tree during a sweep changes nothing; without BIN the tree is built and used.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh >/dev/null
+if [ -n "${BIN:-}" ]; then
+  export LD_LIBRARY_PATH="$(dirname "$(dirname "$BIN")")/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+else
+  bash scripts/build.sh >/dev/null
+  BIN=./build/bin/dynamap
+fi
 DATA=${DATA:-../shared/data}
 OUT=${OUT:-runs/sweep}
 STARTS=${STARTS:-"0 10 20 30 40 50"}
@@ -32,7 +39,7 @@ subset() {  # subset <source dir> <dest dir> <start> <stride>: frame lists cut, 
 }
 
 ate_cm() {  # ate_cm <seq> <run>
-  ./build/bin/dynamap evaluate --gt "$1/groundtruth.txt" --est "$2/trajectory.txt" --json |
+  "$BIN" evaluate --gt "$1/groundtruth.txt" --est "$2/trajectory.txt" --json |
     /usr/bin/python3 -c 'import json,sys; print("%.3f" % (100 * json.load(sys.stdin)["ate"]["rmse_m"]))'
 }
 
@@ -51,7 +58,7 @@ for start in $STARTS; do
       seq="$OUT/seq_${name}_${start}_${stride}"
       subset "$DATA/${spec#*:}" "$seq" "$start" "$stride"
       run="$OUT/run_${name}_${start}_${stride}"
-      ./build/bin/dynamap run --sequence "$seq" --out "$run" --quiet "${cfg[@]}" "$@" >"$run.log" 2>&1 ||
+      "$BIN" run --sequence "$seq" --out "$run" --quiet "${cfg[@]}" "$@" >"$run.log" 2>&1 ||
         echo "sweep: $run failed" >&2
       a=$(ate_cm "$seq" "$run")
       printf ' %9s' "$a"

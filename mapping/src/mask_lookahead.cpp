@@ -21,11 +21,13 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
   const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
   const auto margin = static_cast<float>(occluder_margin_m);
   const int w = later_mask.cols, h = later_mask.rows;
-  for (int v = 0; v < depth_m.rows; ++v) {
+  // Every 2nd pixel of every 2nd row, marking its 2 x 2 block: a quarter of the projections.
+  constexpr int kStride = 2;
+  const cv::Rect image(0, 0, out.cols, out.rows);
+  for (int v = 0; v < depth_m.rows; v += kStride) {
     const float* z_row = depth_m.ptr<float>(v);
-    std::uint8_t* out_row = out.ptr<std::uint8_t>(v);
     const float y_n = (static_cast<float>(v) - cy) / fy;
-    for (int u = 0; u < depth_m.cols; ++u) {
+    for (int u = 0; u < depth_m.cols; u += kStride) {
       const float z = z_row[u];
       if (!(z > 0.0f)) continue;
       const Eigen::Vector3f p =
@@ -36,7 +38,9 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       if (ul < 0 || vl < 0 || ul >= w || vl >= h) continue;
       if (later_mask.at<std::uint8_t>(vl, ul) == 0) continue;
       const float seen = later_depth_m.at<float>(vl, ul);
-      if (seen > 0.0f && seen >= p.z() - margin) out_row[u] = 255;
+      if (seen > 0.0f && seen >= p.z() - margin) {
+        out(cv::Rect(u, v, kStride, kStride) & image).setTo(255);
+      }
     }
   }
   return out;
