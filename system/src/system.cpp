@@ -49,10 +49,21 @@ void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
   }
 }
 
+namespace {
+constexpr double kLookaheadMaxMoveM = 0.3;    ///< 9 m/s at 30 frames/s over one frame
+constexpr double kLookaheadMaxTurnRad = 0.5;  ///< about 29 degrees
+}  // namespace
+
 void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
                              std::vector<KeyframePacketPtr>& mapped) {
   if (!pending) return;
-  if (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized) {
+  // A frame or two later the camera is near where the keyframe was; a pose far from it is
+  // another map's (a restart after a loss) and says nothing about the keyframe's pixels.
+  const Eigen::Isometry3d delta = pending->T_W_C.inverse() * tracked.T_W_C;
+  const bool near = delta.translation().norm() < kLookaheadMaxMoveM &&
+                    Eigen::AngleAxisd(delta.rotation()).angle() < kLookaheadMaxTurnRad;
+  if (near &&
+      (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized)) {
     ScopedStageTimer timer(timings, "mask_lookahead");
     // Only what the later frame saw moving: a person masked there for lack of evidence that
     // they stand still (held back) is no evidence against the keyframe's pixels.
