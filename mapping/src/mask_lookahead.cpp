@@ -4,6 +4,10 @@
 #include <cstdint>
 
 namespace dynamap {
+namespace {
+constexpr double kMaxMoveM = 0.3;    ///< 9 m/s at 30 frames/s over one frame
+constexpr double kMaxTurnRad = 0.5;  ///< about 29 degrees
+}  // namespace
 
 cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
                       const Eigen::Isometry3d& T_W_K, const cv::Mat& later_depth_m,
@@ -14,7 +18,12 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       cv::countNonZero(later_mask) == 0) {
     return out;
   }
-  const Eigen::Isometry3f T_L_K = (T_W_L.inverse() * T_W_K).cast<float>();
+  const Eigen::Isometry3d T_L_K_d = T_W_L.inverse() * T_W_K;
+  if (T_L_K_d.translation().norm() >= kMaxMoveM ||
+      Eigen::AngleAxisd(T_L_K_d.rotation()).angle() >= kMaxTurnRad) {
+    return out;  // another map's pose (a restart after a loss), not a frame or two later
+  }
+  const Eigen::Isometry3f T_L_K = T_L_K_d.cast<float>();
   const Eigen::Matrix3f R = T_L_K.linear();
   const Eigen::Vector3f t = T_L_K.translation();
   const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);

@@ -49,21 +49,10 @@ void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
   }
 }
 
-namespace {
-constexpr double kLookaheadMaxMoveM = 0.3;    ///< 9 m/s at 30 frames/s over one frame
-constexpr double kLookaheadMaxTurnRad = 0.5;  ///< about 29 degrees
-}  // namespace
-
 void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
                              std::vector<KeyframePacketPtr>& mapped) {
   if (!pending) return;
-  // A frame or two later the camera is near where the keyframe was; a pose far from it is
-  // another map's (a restart after a loss) and says nothing about the keyframe's pixels.
-  const Eigen::Isometry3d delta = pending->T_W_C.inverse() * tracked.T_W_C;
-  const bool near = delta.translation().norm() < kLookaheadMaxMoveM &&
-                    Eigen::AngleAxisd(delta.rotation()).angle() < kLookaheadMaxTurnRad;
-  if (near &&
-      (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized)) {
+  if (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized) {
     ScopedStageTimer timer(timings, "mask_lookahead");
     // Only what the later frame saw moving: a person masked there for lack of evidence that
     // they stand still (held back) is no evidence against the keyframe's pixels.
@@ -74,12 +63,8 @@ void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& track
     }
     const cv::Mat later = maskSeenLater(camera, pending->depth_m, pending->T_W_C, frame.depth_m,
                                         tracked.T_W_C, moving);
-    if (cv::countNonZero(later) > 0) {
-      if (pending->dynamic_mask.empty()) {
-        pending->dynamic_mask = later;
-      } else {
-        cv::bitwise_or(pending->dynamic_mask, later, pending->dynamic_mask);
-      }
+    if (cv::countNonZero(later) > 0) {  // a new Mat: the tracker's keyframe keeps its own mask
+      pending->dynamic_mask = pending->dynamic_mask.empty() ? later : pending->dynamic_mask | later;
     }
   }
   if (++pending_seen >= lookahead_frames) releasePending(mapped);
@@ -160,14 +145,9 @@ TrackOutput System::track(const RgbdFrame& frame) {
     out.is_keyframe = true;
     out.keyframe = tracked.keyframe;
     s.releasePending(out.mapped);
-    if (s.lookahead_frames > 0) {
-      s.pending = std::make_shared<KeyframePacket>(*tracked.keyframe);
-      s.pending->dynamic_mask = tracked.keyframe->dynamic_mask.clone();
-      s.pending_seen = 0;
-    } else {
-      out.mapped.push_back(tracked.keyframe);
-      s.pushKeyframe(tracked.keyframe);
-    }
+    s.pending = std::make_shared<KeyframePacket>(*tracked.keyframe);
+    s.pending_seen = 0;
+    if (s.lookahead_frames == 0) s.releasePending(out.mapped);
   }
   const auto updates = s.tracker->takePoseUpdates();
   if (!updates.empty()) s.mapper->applyPoseUpdates(updates);

@@ -13,7 +13,9 @@ namespace dynamap {
 /// frame saw the same surface there, or one behind it: not an occluder that moved in front of
 /// it (nearer by more than `occluder_margin_m`). A person the detector finds a moment after a
 /// keyframe (the first frame of a map has no motion evidence at all) was there in the keyframe
-/// too, a few pixels away. Returns CV_8UC1 of the keyframe's size, 255 = marked.
+/// too, a few pixels away. Nothing is marked when the two poses lie more than 0.3 m or 29 degrees
+/// apart (another map's pose after a restart). Returns CV_8UC1 of the keyframe's size, 255 =
+/// marked.
 cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
                       const Eigen::Isometry3d& T_W_K, const cv::Mat& later_depth_m,
                       const Eigen::Isometry3d& T_W_L, const cv::Mat& later_mask,
