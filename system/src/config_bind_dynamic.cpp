@@ -23,8 +23,8 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
                    {"yolo_darknet", "yolov5_onnx", "yolov8_onnx", "nanodet_onnx", "none"});
   schema.addString("dynamic.model_cfg", &c.model_cfg);
   schema.addString("dynamic.model_weights", &c.model_weights);
-  schema.addInt("dynamic.input_width", &c.input_width, 32, 4096);
-  schema.addInt("dynamic.input_height", &c.input_height, 32, 4096);
+  schema.addInt("dynamic.input_width", &c.input_width, 0, 4096);
+  schema.addInt("dynamic.input_height", &c.input_height, 0, 4096);
   schema.addDouble("dynamic.score_threshold", &c.score_threshold, 0.0, 1.0);
   schema.addDouble("dynamic.high_dynamic_score_threshold", &c.high_dynamic_score_threshold, 0.0,
                    1.0);

@@ -252,9 +252,18 @@ std::vector<Detection> NanoDetDetector::candidates(const cv::Mat& bgr) {
 
 }  // namespace
 
+int defaultInputSize(const std::string& kind) {
+  if (kind == "yolo_darknet") return 256;
+  if (kind == "nanodet_onnx") return 320;
+  if (kind == "yolov5_onnx" || kind == "yolov8_onnx") return 640;
+  return 0;
+}
+
 std::unique_ptr<ObjectDetector> makeObjectDetector(const DetectorOptions& options,
                                                    const ClassTable& class_table) {
   DetectorOptions o = options;
+  if (o.input_width <= 0) o.input_width = defaultInputSize(o.kind);
+  if (o.input_height <= 0) o.input_height = defaultInputSize(o.kind);
   o.nms.class_score_threshold = class_table.scoreThresholds();
   if (o.kind == "yolo_darknet") return std::make_unique<DarknetDetector>(o);
   if (o.kind == "yolov5_onnx") return std::make_unique<YoloOnnxDetector>(o, false);

@@ -24,8 +24,8 @@ struct DetectorOptions {
   std::string kind = "yolo_darknet";  ///< yolo_darknet | yolov5_onnx | yolov8_onnx | nanodet_onnx
   std::string model_cfg;              ///< Darknet .cfg (unused for ONNX)
   std::string model_weights;          ///< Darknet .weights or .onnx
-  int input_width = 320;
-  int input_height = 320;
+  int input_width = 0;   ///< network input; 0 = defaultInputSize(kind)
+  int input_height = 0;  ///< network input; 0 = defaultInputSize(kind)
   NmsOptions nms;
 };
 
@@ -36,6 +36,12 @@ class ObjectDetector {
   /// Final detections (after NMS) in image pixels.
   virtual std::vector<Detection> detect(const cv::Mat& bgr) = 0;
 };
+
+/// The square input a kind of detector runs at when none is given: yolo_darknet (Yolo-Fastest)
+/// 256, measured as accurate as 320 for people at 2/3 of the cost (BENCHMARKS.md, "Detector
+/// input"); nanodet_onnx 320 (its export is fixed at that size); yolov5_onnx / yolov8_onnx 640
+/// (their usual export). 0 for an unknown kind.
+int defaultInputSize(const std::string& kind);
 
 /// Builds the detector; throws DetectorError (naming the file) for a missing file, a file
 /// OpenCV cannot read, or a network whose outputs do not have the expected layout.
