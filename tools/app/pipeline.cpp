@@ -12,6 +12,7 @@
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/system.hpp"
+#include "frame_prefetch.hpp"
 #include "given_masks.hpp"
 #include "image_io.hpp"
 #include "interrupt.hpp"
@@ -123,6 +124,7 @@ void Pipeline::processFrames(RunResult& result) {
     return start +
            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s));
   };
+  FramePrefetcher frames(sequence_);
   for (std::size_t i = 0; i < total; ++i) {
     if (interruptRequested()) {
       result.status = "interrupted";
@@ -137,7 +139,11 @@ void Pipeline::processFrames(RunResult& result) {
         continue;
       }
     }
-    processFrame(i, result);
+    const auto read_start = Clock::now();
+    FrameLoad load = frames.take(i);
+    timings_.add("frame_read",
+                 std::chrono::duration<double, std::milli>(Clock::now() - read_start).count());
+    processFrame(i, load, result);
     if (options_.realtime) {
       timings_.add("realtime_lag",
                    std::chrono::duration<double, std::milli>(Clock::now() - arrival(i)).count());
@@ -146,10 +152,9 @@ void Pipeline::processFrames(RunResult& result) {
   }
 }
 
-void Pipeline::processFrame(std::size_t index, RunResult& result) {
+void Pipeline::processFrame(std::size_t index, const FrameLoad& load, RunResult& result) {
   auto& s = *stages_;
   const SequenceEntry& entry = sequence_.entries()[index];
-  FrameLoad load = sequence_.load(index);
   ++result.counts.frames_read;
   if (!load.ok) {
     ++result.counts.bad_frames;

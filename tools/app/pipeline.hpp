@@ -66,7 +66,7 @@ class Pipeline {
  private:
   struct Stages;
   void processFrames(RunResult& result);
-  void processFrame(std::size_t index, RunResult& result);
+  void processFrame(std::size_t index, const FrameLoad& load, RunResult& result);
   void finalize(RunResult& result);
   /// Scores (and with --save-masks writes) the masks of keyframes handed to the mapper.
   void mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped, RunResult& result);

@@ -1,0 +1,26 @@
+#include "frame_prefetch.hpp"
+
+namespace dynamap {
+
+FramePrefetcher::~FramePrefetcher() {
+  if (pending_.valid()) pending_.wait();  // the reading thread uses sequence_: let it finish
+}
+
+FrameLoad FramePrefetcher::take(std::size_t index) {
+  FrameLoad load;
+  if (pending_.valid() && pending_index_ == index) {
+    load = pending_.get();
+  } else {
+    if (pending_.valid()) pending_.wait();  // a frame skipped (--realtime): not needed
+    pending_ = {};
+    load = sequence_.load(index);
+  }
+  if (index + 1 < sequence_.size()) {
+    pending_index_ = index + 1;
+    pending_ =
+        std::async(std::launch::async, [this, next = index + 1] { return sequence_.load(next); });
+  }
+  return load;
+}
+
+}  // namespace dynamap

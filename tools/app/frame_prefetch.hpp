@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstddef>
+#include <future>
+
+#include "tum_dataset.hpp"
+
+namespace dynamap {
+
+/// Reads the next frame of a sequence on another thread while the caller processes this one:
+/// decoding a colour JPEG/PNG and a 16-bit depth PNG takes ~13 ms a frame, which would
+/// otherwise sit on the tracking thread's path. take(i) returns frame i exactly as
+/// TumSequence::load(i) would (same bytes, same errors) and starts reading i + 1.
+class FramePrefetcher {
+ public:
+  explicit FramePrefetcher(const TumSequence& sequence) : sequence_(sequence) {}
+  ~FramePrefetcher();
+  FramePrefetcher(const FramePrefetcher&) = delete;
+  FramePrefetcher& operator=(const FramePrefetcher&) = delete;
+
+  /// Frame `index` (waits for it if it is being read; reads it now if another one was).
+  FrameLoad take(std::size_t index);
+
+ private:
+  const TumSequence& sequence_;
+  std::future<FrameLoad> pending_;
+  std::size_t pending_index_ = 0;
+};
+
+}  // namespace dynamap
