@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "frame_prefetch.hpp"
 #include "test_paths.hpp"
 
 namespace dynamap {
@@ -182,6 +183,31 @@ TEST(TumSequence, BadFramesAreValuesNotExceptions) {
   EXPECT_FALSE(f.ok);
   EXPECT_NE(f.error.find("missing image"), std::string::npos) << f.error;
   EXPECT_FALSE(seq.load(3).ok);  // out of range
+}
+
+// The prefetcher hands out exactly what load() gives, in order, after a skipped frame (the
+// realtime mode drops stale frames) and for a bad frame (an error value, not an exception).
+TEST(FramePrefetcher, GivesWhatLoadGivesInOrderAndAfterASkip) {
+  const fs::path dir = makeSequence("seq_prefetch");
+  const TumSequence seq = TumSequence::open(dir.string(), smallCameraOptions());
+  writeText(seq.entries()[2].rgb_path, "not an image");
+  const auto same = [&](const FrameLoad& got, std::size_t i) {
+    const FrameLoad want = seq.load(i);
+    EXPECT_EQ(got.ok, want.ok) << i;
+    EXPECT_EQ(got.error, want.error) << i;
+    if (!want.ok) return;
+    EXPECT_EQ(got.frame.timestamp_s, want.frame.timestamp_s) << i;
+    EXPECT_EQ(cv::norm(got.frame.bgr, want.frame.bgr, cv::NORM_INF), 0.0) << i;
+    EXPECT_EQ(cv::norm(got.frame.depth_m, want.frame.depth_m, cv::NORM_INF), 0.0) << i;
+  };
+  {
+    FramePrefetcher frames(seq);
+    for (std::size_t i = 0; i < seq.size(); ++i) same(frames.take(i), i);
+  }
+  FramePrefetcher frames(seq);
+  same(frames.take(0), 0);
+  same(frames.take(2), 2);  // frame 1 was being read: dropped
+  same(frames.take(1), 1);  // back again (not what the pipeline does, but still right)
 }
 
 fs::path teddyDir() { return test::sharedData() / "tum" / "rgbd_dataset_freiburg3_teddy"; }
