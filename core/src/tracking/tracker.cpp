@@ -20,13 +20,6 @@ cv::Mat toGray(const cv::Mat& image, const PinholeCamera& camera) {
   return gray;
 }
 
-TrackerConfig probeLkConfig(TrackerConfig config) {
-  if (config.motion_probe_window_px > 0) config.lk_window_px = config.motion_probe_window_px;
-  if (config.motion_probe_lk_iterations > 0)
-    config.lk_max_iterations = config.motion_probe_lk_iterations;
-  return config;
-}
-
 }  // namespace
 
 Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
@@ -37,7 +30,6 @@ Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
       timings_(timings),
       extractor_(config),
       lk_(config),
-      probe_lk_(probeLkConfig(config)),
       optimizer_(camera, config),
       relocalizer_(config, optimizer_) {
   if (config_.bundle_adjustment) ba_.start();
@@ -225,7 +217,7 @@ void Tracker::Impl::trackProbes(const LkPyramid& cur, FeatureMatches& matches) {
   std::vector<cv::Point2f> cur_px(probes_.size());
   for (std::size_t i = 0; i < probes_.size(); ++i) cur_px[i] = probes_[i] + flow;
   std::vector<std::uint8_t> ok;
-  probe_lk_.track(prev_pyramid_, cur, probes_, cur_px, ok);
+  lk_.track(prev_pyramid_, cur, probes_, cur_px, ok);
   std::vector<cv::Point2f> kept;
   std::vector<std::uint64_t> kept_ids;
   kept.reserve(probes_.size());

@@ -27,10 +27,7 @@ struct TrackerConfig {
   /// are dropped, and a mover without tracks gets no mask). 0 = landmark tracks only.
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
-  int motion_probe_level = 0;      ///< pyramid level probes are found on (1 = half resolution)
-  int motion_probe_window_px = 0;  ///< LK window of the probes; 0 = lk_window_px
-  int motion_probe_lk_iterations =
-      0;  ///< LK iterations per level for probes; 0 = lk_max_iterations
+  int motion_probe_level = 0;  ///< pyramid level probes are found on (1 = half resolution)
 
   /// With a motion filter: the camera motion handed to it is first estimated against the
   /// tracked landmarks that at least this many keyframes observed (those proven static over

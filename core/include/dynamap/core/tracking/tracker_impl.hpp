@@ -90,7 +90,6 @@ class Tracker::Impl {
   TimingRecorder* timings_;
   GridOrbExtractor extractor_;
   LkTracker lk_;
-  LkTracker probe_lk_;  ///< the probes' LK (their own window and iterations when set)
   PoseOptimizer optimizer_;
   Relocalizer relocalizer_;
 
