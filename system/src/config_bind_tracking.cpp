@@ -18,7 +18,6 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.lk_fb_threshold_px", &c.lk_fb_threshold_px, 0.01, 20.0);
   schema.addInt("tracking.motion_probes", &c.motion_probes, 0, 10000);
   schema.addInt("tracking.motion_probe_min_distance_px", &c.motion_probe_min_distance_px, 1, 200);
-  schema.addInt("tracking.motion_probe_level", &c.motion_probe_level, 0, 3);
   schema.addInt("tracking.static_prior_min_keyframes", &c.static_prior_min_keyframes, 0, 1000);
   schema.addInt("tracking.dynamic_margin_px", &c.dynamic_margin_px, 0, 200);
   schema.addDouble("tracking.motion_prior_sigma_m", &c.motion_prior_sigma_m, 0.0, 100.0);

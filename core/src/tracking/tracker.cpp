@@ -243,21 +243,12 @@ void Tracker::Impl::refillProbes(const cv::Mat& gray) {
   }
   if (static_cast<int>(probes_.size()) >= wanted * 7 / 10) return;
   ScopedStageTimer timer(timings_, "probes");
-  // Corners are found on a pyramid level (1 = half resolution: a quarter of the cost; LK then
-  // tracks them at full resolution) away from the probes already there.
-  const int level = std::max(0, config_.motion_probe_level);
-  const double scale = 1.0 / (1 << level);
-  cv::Mat image = gray;
-  for (int l = 0; l < level; ++l) cv::pyrDown(image, image);
-  const int spacing = std::max(1, static_cast<int>(config_.motion_probe_min_distance_px * scale));
-  cv::Mat allowed(image.size(), CV_8UC1, cv::Scalar(255));
-  for (const auto& p : probes_) cv::circle(allowed, p * scale, spacing, cv::Scalar(0), -1);
+  const int spacing = std::max(1, config_.motion_probe_min_distance_px);
+  cv::Mat allowed(gray.size(), CV_8UC1, cv::Scalar(255));
+  for (const auto& p : probes_) cv::circle(allowed, p, spacing, cv::Scalar(0), -1);
   std::vector<cv::Point2f> fresh;
-  cv::goodFeaturesToTrack(image, fresh, wanted - static_cast<int>(probes_.size()), 0.01, spacing,
+  cv::goodFeaturesToTrack(gray, fresh, wanted - static_cast<int>(probes_.size()), 0.01, spacing,
                           allowed);
-  const auto up = static_cast<float>(1 << level);
-  const float offset = 0.5f * (up - 1.f);  // centre of the level's pixel at full resolution
-  for (auto& p : fresh) p = p * up + cv::Point2f(offset, offset);
   probes_.insert(probes_.end(), fresh.begin(), fresh.end());
   for (std::size_t i = 0; i < fresh.size(); ++i)
     probe_ids_.push_back(kProbeIdBit | next_probe_id_++);

@@ -27,7 +27,6 @@ struct TrackerConfig {
   /// are dropped, and a mover without tracks gets no mask). 0 = landmark tracks only.
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
-  int motion_probe_level = 0;  ///< pyramid level probes are found on (1 = half resolution)
 
   /// With a motion filter: the camera motion handed to it is first estimated against the
   /// tracked landmarks that at least this many keyframes observed (those proven static over
