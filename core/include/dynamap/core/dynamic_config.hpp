@@ -42,9 +42,9 @@ struct DynamicConfig {
                                           ///< nanodet_onnx | none
   std::string model_cfg = "../shared/models/yolo-fastest/yolo-fastest-1.1-xl.cfg";
   std::string model_weights = "../shared/models/yolo-fastest/yolo-fastest-1.1-xl.weights";
-  int input_width = 0;   ///< detector input; 0 = the detector's default (defaultInputSize)
-  int input_height = 0;  ///< detector input; 0 = the detector's default (defaultInputSize)
-  double score_threshold = 0.25;               ///< low-dynamic classes
+  int input_width = 0;            ///< detector input; 0 = the detector's default (defaultInputSize)
+  int input_height = 0;           ///< detector input; 0 = the detector's default (defaultInputSize)
+  double score_threshold = 0.25;  ///< low-dynamic classes
   double high_dynamic_score_threshold = 0.15;  ///< high-dynamic classes (recall first)
   double nms_iou_threshold = 0.45;
   std::string nms = "recall";  ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)

@@ -24,8 +24,8 @@ struct DetectorOptions {
   std::string kind = "yolo_darknet";  ///< yolo_darknet | yolov5_onnx | yolov8_onnx | nanodet_onnx
   std::string model_cfg;              ///< Darknet .cfg (unused for ONNX)
   std::string model_weights;          ///< Darknet .weights or .onnx
-  int input_width = 0;   ///< network input; 0 = defaultInputSize(kind)
-  int input_height = 0;  ///< network input; 0 = defaultInputSize(kind)
+  int input_width = 0;                ///< network input; 0 = defaultInputSize(kind)
+  int input_height = 0;               ///< network input; 0 = defaultInputSize(kind)
   NmsOptions nms;
 };
 
