@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the test suite under sanitizers (clang):
 #   asan: everything under AddressSanitizer + UndefinedBehaviorSanitizer, in build-asan
-#   tsan: the threaded tests (tracking BA thread, mapping worker, CLI runs) under
+#   tsan: the threaded tests (tracking BA thread, mapping worker, visibility pass, CLI runs) under
 #         ThreadSanitizer, in build-tsan, with scripts/tsan.supp
 #   scripts/sanitize.sh [asan|tsan|all]   (default all)
 # Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, JOBS (compile jobs, default 2), CTEST_ARGS (extra).
@@ -58,7 +58,7 @@ run_tsan() {
     dynamap_tracking_tests dynamap_mapping_tests dynamap_cli_tests
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
-  nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|AllBackends/BackendContract|RunCommand|FaultInjection|Determinism)\\.}" \
+  nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|Visibility|AllBackends/VisibilityAllBackends|AllBackends/BackendContract|RunCommand|FaultInjection|Determinism)\\.}" \
       -E "${TSAN_EXCLUDE:-RealtimeModeKeepsTrackingLagBounded}" --output-on-failure -j1 ${CTEST_ARGS:-}
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -38,6 +39,21 @@ struct Element {
   std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
 };
 
+/// Runs job(0) on another thread and job(1) on this one (the machine's 2 cores; every parallel
+/// step below splits its work in two by index, each half with its own accumulators).
+template <typename Job>
+void inTwo(const Job& job) {
+  std::thread other([&] { job(0); });
+  job(1);
+  other.join();
+}
+
+/// A keyframe's static points and their voxel keys, sorted by key (then by point).
+struct KeyedPoints {
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  std::vector<Eigen::Vector3f> points;
+};
+
 /// Runs fn(depth, u, v, p_W) for every static pixel of a keyframe.
 template <typename T, typename Fn>
 void forEachStaticPointT(const PinholeCamera& camera, const VisibilityKeyframe& kf, const Fn& fn) {
@@ -69,22 +85,30 @@ class ElementTable {
  public:
   explicit ElementTable(double voxel_m) : inv_voxel_(static_cast<float>(1.0 / voxel_m)) {}
 
-  /// Adds a keyframe's points: sorted by voxel, one hash access per distinct voxel.
-  void add(const PinholeCamera& camera, const VisibilityKeyframe& kf) {
-    keyed_.clear();
-    points_.clear();
+  /// A keyframe's points keyed by voxel and sorted. Thread-safe (reads only the voxel size).
+  void keyPoints(const PinholeCamera& camera, const VisibilityKeyframe& kf,
+                 KeyedPoints& out) const {
+    out.keyed.clear();
+    out.points.clear();
     forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
-      keyed_.emplace_back(voxelKey(p_W, inv_voxel_), static_cast<std::uint32_t>(points_.size()));
-      points_.push_back(p_W);
+      out.keyed.emplace_back(voxelKey(p_W, inv_voxel_),
+                             static_cast<std::uint32_t>(out.points.size()));
+      out.points.push_back(p_W);
     });
-    std::sort(keyed_.begin(), keyed_.end());
-    for (std::size_t b = 0; b < keyed_.size();) {
+    std::sort(out.keyed.begin(), out.keyed.end());
+  }
+
+  /// Adds a keyframe's keyed points: one hash access per distinct voxel. Keyframes must be
+  /// added in the same order on every run (the element order and the float sums depend on it).
+  void add(const KeyedPoints& in) {
+    const auto& keyed = in.keyed;
+    for (std::size_t b = 0; b < keyed.size();) {
       const auto [it, inserted] =
-          index_.try_emplace(keyed_[b].first, static_cast<std::uint32_t>(elements_.size()));
+          index_.try_emplace(keyed[b].first, static_cast<std::uint32_t>(elements_.size()));
       if (inserted) elements_.emplace_back();
       Element& e = elements_[it->second];
-      for (; b < keyed_.size() && keyed_[b].first == it->first; ++b) {
-        e.sum += points_[keyed_[b].second];
+      for (; b < keyed.size() && keyed[b].first == it->first; ++b) {
+        e.sum += in.points[keyed[b].second];
         ++e.count;
       }
     }
@@ -97,9 +121,11 @@ class ElementTable {
     }
   }
 
-  /// Counts, for every element, whether this view saw through it.
+  /// Counts, for the elements [begin, end), whether this view saw through them. Thread-safe for
+  /// disjoint ranges.
   void project(const PinholeCamera& camera, const VisibilityView& view,
-               const Eigen::Isometry3d& T_W_C, const VisibilityOptions& options) {
+               const Eigen::Isometry3d& T_W_C, const VisibilityOptions& options, std::size_t begin,
+               std::size_t end) {
     const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
     const Eigen::Matrix3f R = T_C_W.linear();
     const Eigen::Vector3f t = T_C_W.translation();
@@ -111,7 +137,7 @@ class ElementTable {
     const auto cap = static_cast<std::uint32_t>(std::max(1, options.min_views));
     const int w = view.near_m.cols, h = view.near_m.rows;
     const bool has_mask = view.moving.size() == view.near_m.size();
-    for (std::size_t i = 0; i < centroids_.size(); ++i) {
+    for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3f p = R * centroids_[i] + t;
       if (p.z() < kMinDepthM) continue;
       const float uf = fx * p.x() / p.z() + cx, vf = fy * p.y() / p.z() + cy;
@@ -160,8 +186,6 @@ class ElementTable {
   std::unordered_map<std::uint64_t, std::uint32_t> index_;
   std::vector<Element> elements_;
   std::vector<Eigen::Vector3f> centroids_;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;  // scratch
-  std::vector<Eigen::Vector3f> points_;                         // scratch
 };
 
 }  // namespace
@@ -197,38 +221,64 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
                                    std::vector<VisibilityKeyframe>& keyframes,
                                    const VisibilityOptions& options) {
   VisibilityResult result;
-  result.per_keyframe_ms.assign(keyframes.size(), 0.0);
+  const std::size_t n = keyframes.size();
+  // Per keyframe and half of the work: CPU ms, summed into per_keyframe_ms at the end.
+  std::vector<double> ms[2] = {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
   ElementTable table(options.voxel_m);
-  for (std::size_t i = 0; i < keyframes.size(); ++i) {
-    const auto t0 = Clock::now();
-    if (keyframes[i].static_depth != nullptr) table.add(camera, keyframes[i]);
-    result.per_keyframe_ms[i] += msSince(t0);
-  }
-  table.computeCentroids();
-  for (std::size_t j = 0; j < keyframes.size(); ++j) {
-    const auto t0 = Clock::now();
-    const VisibilityView* view = keyframes[j].view;
-    if (view != nullptr && !view->near_m.empty()) {
-      table.project(camera, *view, keyframes[j].T_W_C, options);
+  // Keyframes are keyed two at a time (one per thread) and added in their order.
+  KeyedPoints keyed[2];
+  for (std::size_t i = 0; i < n; i += 2) {
+    inTwo([&](int h) {
+      const std::size_t k = i + static_cast<std::size_t>(h);
+      if (k >= n || keyframes[k].static_depth == nullptr) return;
+      const auto t0 = Clock::now();
+      table.keyPoints(camera, keyframes[k], keyed[h]);
+      ms[h][k] += msSince(t0);
+    });
+    for (int h = 0; h < 2; ++h) {
+      const std::size_t k = i + static_cast<std::size_t>(h);
+      if (k >= n || keyframes[k].static_depth == nullptr) continue;
+      const auto t0 = Clock::now();
+      table.add(keyed[h]);
+      ms[h][k] += msSince(t0);
     }
-    result.per_keyframe_ms[j] += msSince(t0);
   }
+  keyed[0] = keyed[1] = KeyedPoints{};
+  table.computeCentroids();
+  const std::size_t half = table.size() / 2;
+  inTwo([&](int h) {  // each half of the elements against every view
+    for (std::size_t j = 0; j < n; ++j) {
+      const VisibilityView* view = keyframes[j].view;
+      if (view == nullptr || view->near_m.empty()) continue;
+      const auto t0 = Clock::now();
+      table.project(camera, *view, keyframes[j].T_W_C, options, h == 0 ? 0 : half,
+                    h == 0 ? half : table.size());
+      ms[h][j] += msSince(t0);
+    }
+  });
   result.elements = table.size();
   const std::unordered_set<std::uint64_t> removed = table.removedKeys(options, &result.mask_voted);
   result.seen_through = removed.size() - result.mask_voted;
   result.element_bytes = table.bytes();
-  if (removed.empty()) return result;
-  for (std::size_t i = 0; i < keyframes.size(); ++i) {
-    const auto t0 = Clock::now();
-    if (keyframes[i].static_depth == nullptr) continue;
-    forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
-      if (removed.count(table.key(p_W)) != 0) {
-        depth = 0;
-        ++result.removed_pixels;
+  if (!removed.empty()) {
+    std::size_t removed_pixels[2] = {0, 0};
+    inTwo([&](int h) {  // every other keyframe: each thread writes only its keyframes' depth
+      for (std::size_t i = static_cast<std::size_t>(h); i < n; i += 2) {
+        if (keyframes[i].static_depth == nullptr) continue;
+        const auto t0 = Clock::now();
+        forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
+          if (removed.count(table.key(p_W)) != 0) {
+            depth = 0;
+            ++removed_pixels[h];
+          }
+        });
+        ms[h][i] += msSince(t0);
       }
     });
-    result.per_keyframe_ms[i] += msSince(t0);
+    result.removed_pixels = removed_pixels[0] + removed_pixels[1];
   }
+  result.per_keyframe_ms.resize(n);
+  for (std::size_t i = 0; i < n; ++i) result.per_keyframe_ms[i] = ms[0][i] + ms[1][i];
   return result;
 }
 

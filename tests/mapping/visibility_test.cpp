@@ -180,5 +180,44 @@ TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {
   EXPECT_EQ(r.per_keyframe_ms.size(), 3u);
 }
 
+// The pass splits its work over two threads: an odd number of keyframes (the last pair has one)
+// gives the same edits and counts on every call, and a box left unmasked in the first keyframes
+// is removed from each of them.
+TEST(Visibility, TwoThreadsGiveTheSameResultEveryTime) {
+  const PinholeCamera cam = SyntheticScene::camera();
+  const SyntheticScene scene;
+  constexpr int kKeyframes = 5;
+  VisibilityOptions options;
+  std::vector<SyntheticFrame> frames;
+  std::vector<VisibilityView> views;
+  for (int k = 0; k < kKeyframes; ++k) {
+    frames.push_back(
+        scene.render(k, kKeyframes, k < 2 ? boxAt(0) : Box{{9, 9, 9}, {9.1, 9.1, 9.1}}));
+  }
+  for (const auto& f : frames) views.push_back(makeVisibilityView(f.depth_m, cv::Mat(), options));
+  const auto pass = [&](std::vector<cv::Mat>& depths) {
+    depths.clear();
+    for (const auto& f : frames) depths.push_back(f.depth_m.clone());
+    std::vector<VisibilityKeyframe> kfs;
+    for (int k = 0; k < kKeyframes; ++k)
+      kfs.push_back({&depths[k], 1.0, frames[k].T_W_C, &views[k]});
+    return removeSeenThrough(cam, kfs, options);
+  };
+  std::vector<cv::Mat> first, second;
+  const VisibilityResult a = pass(first), b = pass(second);
+  EXPECT_EQ(a.elements, b.elements);
+  EXPECT_EQ(a.seen_through, b.seen_through);
+  EXPECT_EQ(a.removed_pixels, b.removed_pixels);
+  ASSERT_EQ(a.per_keyframe_ms.size(), static_cast<std::size_t>(kKeyframes));
+  for (int k = 0; k < kKeyframes; ++k) EXPECT_EQ(cv::countNonZero(first[k] != second[k]), 0) << k;
+  for (int k = 0; k < 2; ++k) {
+    const int box_px = cv::countNonZero(frames[k].mask);
+    ASSERT_GT(box_px, 200);
+    const cv::Mat removed = (first[k] == 0) & (frames[k].depth_m > 0);
+    EXPECT_GT(cv::countNonZero(removed & frames[k].mask), 0.9 * box_px) << k;
+    EXPECT_LT(cv::countNonZero(removed & ~frames[k].mask), 0.02 * box_px) << k;
+  }
+}
+
 }  // namespace
 }  // namespace dynamap::test

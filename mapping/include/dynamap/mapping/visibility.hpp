@@ -64,7 +64,10 @@ struct VisibilityResult {
 /// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
 /// dynamic mask (options.mask_min_views, mask_ratio). Anything that every visit saw (a
 /// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
-/// point pairs. Thread-safe for distinct keyframes (modifies only their depth images).
+/// point pairs. Runs on two threads (keyframes keyed two at a time and added in their order,
+/// elements split in halves, removal split by keyframe): the result does not depend on the
+/// threads. per_keyframe_ms is CPU time. Thread-safe for distinct keyframes (modifies only their
+/// depth images).
 VisibilityResult removeSeenThrough(const PinholeCamera& camera,
                                    std::vector<VisibilityKeyframe>& keyframes,
                                    const VisibilityOptions& options);
