@@ -48,9 +48,16 @@ void inTwo(const Job& job) {
   other.join();
 }
 
-/// A keyframe's static points and their voxel keys, sorted by key (then by point).
+/// A keyframe's static points in runs of consecutive points of one voxel (neighbouring pixels of
+/// a row mostly share a 2 cm voxel), the runs sorted by voxel key, then by their first point.
+struct VoxelRun {
+  std::uint64_t key = 0;
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;
+  bool operator<(const VoxelRun& o) const { return key != o.key ? key < o.key : first < o.first; }
+};
 struct KeyedPoints {
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  std::vector<VoxelRun> runs;
   std::vector<Eigen::Vector3f> points;
 };
 
@@ -88,28 +95,34 @@ class ElementTable {
   /// A keyframe's points keyed by voxel and sorted. Thread-safe (reads only the voxel size).
   void keyPoints(const PinholeCamera& camera, const VisibilityKeyframe& kf,
                  KeyedPoints& out) const {
-    out.keyed.clear();
+    out.runs.clear();
     out.points.clear();
     forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
-      out.keyed.emplace_back(voxelKey(p_W, inv_voxel_),
-                             static_cast<std::uint32_t>(out.points.size()));
+      const std::uint64_t key = voxelKey(p_W, inv_voxel_);
+      const auto index = static_cast<std::uint32_t>(out.points.size());
       out.points.push_back(p_W);
+      if (!out.runs.empty() && out.runs.back().key == key) {
+        ++out.runs.back().count;
+      } else {
+        out.runs.push_back({key, index, 1});
+      }
     });
-    std::sort(out.keyed.begin(), out.keyed.end());
+    std::sort(out.runs.begin(), out.runs.end());
   }
 
-  /// Adds a keyframe's keyed points: one hash access per distinct voxel. Keyframes must be
-  /// added in the same order on every run (the element order and the float sums depend on it).
+  /// Adds a keyframe's keyed points, point by point in (voxel, point) order: one hash access per
+  /// distinct voxel. Keyframes must be added in the same order on every run (the element order
+  /// and the float sums depend on it).
   void add(const KeyedPoints& in) {
-    const auto& keyed = in.keyed;
-    for (std::size_t b = 0; b < keyed.size();) {
+    const auto& runs = in.runs;
+    for (std::size_t b = 0; b < runs.size();) {
       const auto [it, inserted] =
-          index_.try_emplace(keyed[b].first, static_cast<std::uint32_t>(elements_.size()));
+          index_.try_emplace(runs[b].key, static_cast<std::uint32_t>(elements_.size()));
       if (inserted) elements_.emplace_back();
       Element& e = elements_[it->second];
-      for (; b < keyed.size() && keyed[b].first == it->first; ++b) {
-        e.sum += in.points[keyed[b].second];
-        ++e.count;
+      for (; b < runs.size() && runs[b].key == it->first; ++b) {
+        for (std::uint32_t i = 0; i < runs[b].count; ++i) e.sum += in.points[runs[b].first + i];
+        e.count += runs[b].count;
       }
     }
   }
@@ -266,8 +279,15 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
       for (std::size_t i = static_cast<std::size_t>(h); i < n; i += 2) {
         if (keyframes[i].static_depth == nullptr) continue;
         const auto t0 = Clock::now();
+        std::uint64_t last_key = 0;  // neighbouring pixels mostly share a voxel: one lookup
+        bool last_removed = false, any = false;
         forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
-          if (removed.count(table.key(p_W)) != 0) {
+          const std::uint64_t key = table.key(p_W);
+          if (!any || key != last_key) {
+            last_key = key, any = true;
+            last_removed = removed.count(key) != 0;
+          }
+          if (last_removed) {
             depth = 0;
             ++removed_pixels[h];
           }
