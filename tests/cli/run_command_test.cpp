@@ -41,6 +41,16 @@ TEST(RunCommand, WritesEveryOutputOnARealSequence) {
   const std::string timings = test::readFile((out / "timings.json").string());
   EXPECT_NE(timings.find("\"frames_per_s\""), std::string::npos);
   EXPECT_NE(timings.find("\"tracking_median_ms\""), std::string::npos);
+  // End to end = the frames, then finishing: the frames alone run at least as fast.
+  const auto number_at = [&timings](const std::string& key) {
+    const auto p = timings.find("\"" + key + "\":");
+    EXPECT_NE(p, std::string::npos) << key;
+    return p == std::string::npos ? -1.0 : std::stod(timings.substr(p + key.size() + 3));
+  };
+  const double wall_s = number_at("wall_time_s"), finish_s = number_at("finish_s");
+  EXPECT_GT(finish_s, 0.0);
+  EXPECT_LT(finish_s, wall_s);
+  EXPECT_GE(number_at("frames_per_s_before_finish"), number_at("frames_per_s"));
   const std::string metrics = test::readFile((out / "metrics.json").string());
   EXPECT_NE(metrics.find("\"ate\""), std::string::npos);
   EXPECT_NE(metrics.find("\"rpe\""), std::string::npos);

@@ -102,14 +102,16 @@ RunResult Pipeline::run() {
     result.error = e.what();
   }
   if (result.status == "complete" && interruptRequested()) result.status = "interrupted";
+  const auto finish_start = std::chrono::steady_clock::now();
   try {
     finalize(result);
   } catch (const std::exception& e) {
     result.status = "failed";
     result.error += std::string(result.error.empty() ? "" : "; then: ") + e.what();
   }
-  result.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto end = std::chrono::steady_clock::now();
+  result.wall_time_s = std::chrono::duration<double>(end - start).count();
+  result.finish_s = std::chrono::duration<double>(end - finish_start).count();
   return result;
 }
 

@@ -42,10 +42,16 @@ std::string timingsJson(const RunResult& result, const TimingRecorder& timings, 
                     {"max_ms", s.max_ms}};
   }
   const StageStats tracking = timings.stats("tracking");
+  // The frames alone (reading, tracking, mapping as they arrive), without finishing.
+  const double loop_s = result.wall_time_s - result.finish_s;
+  const double loop_fps =
+      loop_s > 0 ? static_cast<double>(result.counts.frames_read) / loop_s : 0.0;
   const Json root = {{"mode", result.mode},
                      {"frames", result.counts.frames_read},
                      {"wall_time_s", result.wall_time_s},
                      {"frames_per_s", fps},
+                     {"finish_s", result.finish_s},
+                     {"frames_per_s_before_finish", loop_fps},
                      {"tracking_median_ms", tracking.median_ms},
                      {"tracking_p95_ms", tracking.p95_ms},
                      {"peak_memory_mib", peakMemoryMiB()},
@@ -135,7 +141,8 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
   const RunCounts& c = result.counts;
   out << "run " << result.status << ": " << c.frames_read << " frames read, " << c.tracked
       << " tracked, " << c.relocalized << " relocalized, " << c.lost << " lost, " << c.bad_frames
-      << " bad; " << c.keyframes << " keyframes; " << report.frames_per_s << " frames/s\n";
+      << " bad; " << c.keyframes << " keyframes; " << report.frames_per_s << " frames/s ("
+      << result.finish_s << " s of it finishing)\n";
   if (!result.error.empty()) out << "error: " << result.error << "\n";
   if (report.evaluation) out << evaluationToTable(*report.evaluation);
   if (!report.map_metrics_json.empty()) out << "map: " << report.map_metrics_json << "\n";
