@@ -3,20 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <exception>
-#include <functional>
-#include <thread>
+
+#include "in_two.hpp"
 
 namespace dynamap {
 namespace {
-
-/// Joins a thread when it goes out of scope (also when an exception leaves the scope).
-struct JoinOnExit {
-  std::thread& thread;
-  ~JoinOnExit() {
-    if (thread.joinable()) thread.join();
-  }
-};
 
 constexpr double kDepthUnitsPerM = 5000.0;
 
@@ -215,41 +206,39 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   if (!moved) return;
   ScopedStageTimer timer(timings_, "mapping_rebuild");
   backend_->reset();
-  // Keyframes are integrated in their order on this thread; the next one's points are made on
-  // another thread meanwhile (it reads only its own record).
-  std::exception_ptr failed;
-  const auto prepare = [this, &failed](std::uint64_t id, StaticPoints& sp) {
-    try {
-      const KeyframeRecord& rec = records_.at(id);
-      rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
-      backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                       &sp.colors);
-    } catch (...) {
-      failed = std::current_exception();
-    }
+  // Keyframes are integrated in their order on this thread while the next one's points are made
+  // on the other (it reads only its own record).
+  const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
+    const KeyframeRecord& rec = records_.at(id);
+    rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
+    backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                     &sp.colors);
   };
-  StaticPoints sp[2];
-  if (!order_.empty()) prepare(order_.front(), sp[0]);
-  for (std::size_t i = 0; i < order_.size() && !failed; ++i) {
-    std::thread next;
-    if (i + 1 < order_.size())
-      next = std::thread(prepare, order_[i + 1], std::ref(sp[(i + 1) % 2]));
-    const JoinOnExit join{next};
-    KeyframeRecord& rec = records_.at(order_[i]);
-    const StaticPoints& now = sp[i % 2];
+  const auto integrate = [this](std::uint64_t id, const StaticPoints& sp) {
+    KeyframeRecord& rec = records_.at(id);
     KeyframeView view;
-    view.id = order_[i];
+    view.id = id;
     view.timestamp_s = rec.timestamp_s;
     view.T_W_C = rec.T_current;
     view.camera = &camera_;
     view.bgr = &rec.bgr;
-    view.static_depth_m = &now.static_depth_m;
-    view.points_C = &now.points_C;
-    view.colors = &now.colors;
+    view.static_depth_m = &sp.static_depth_m;
+    view.points_C = &sp.points_C;
+    view.colors = &sp.colors;
     backend_->integrate(view);
     rec.T_integrated = rec.T_current;
+  };
+  StaticPoints sp[2];
+  if (!order_.empty()) prepare(order_.front(), sp[0]);
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    inTwo([&](int h) {
+      if (h == 1) {
+        integrate(order_[i], sp[i % 2]);
+      } else if (i + 1 < order_.size()) {
+        prepare(order_[i + 1], sp[(i + 1) % 2]);
+      }
+    });
   }
-  if (failed) std::rethrow_exception(failed);
   reintegrated_ = order_.size();
 }
 

@@ -4,11 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <thread>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <opencv2/imgproc.hpp>
+
+#include "in_two.hpp"
 
 namespace dynamap {
 namespace {
@@ -38,15 +39,6 @@ struct Element {
   std::uint16_t observed = 0;  ///< keyframes whose surface at the projection is this element
   std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
 };
-
-/// Runs job(0) on another thread and job(1) on this one (the machine's 2 cores; every parallel
-/// step below splits its work in two by index, each half with its own accumulators).
-template <typename Job>
-void inTwo(const Job& job) {
-  std::thread other([&] { job(0); });
-  job(1);
-  other.join();
-}
 
 /// A keyframe's static points in runs of consecutive points of one voxel (neighbouring pixels of
 /// a row mostly share a 2 cm voxel), the runs sorted by voxel key, then by their first point.

@@ -38,7 +38,7 @@ struct RunResult {
   std::vector<TimedPose> trajectory;      ///< every frame with a pose, final optimised poses
   std::vector<std::string> frame_status;  ///< parallel to trajectory
   std::vector<TimedPose> keyframes;
-  double wall_time_s = 0.0;  ///< the whole run: frames, then finishing (wall_time_s includes it)
+  double wall_time_s = 0.0;  ///< the whole run: the frames, then finishing
   double finish_s = 0.0;     ///< finishing: last bundle adjustment, mapper queue, visibility pass
   std::string backend;
   std::string mode = "offline";  ///< offline | realtime
