@@ -41,11 +41,15 @@ run_asan() {
   # class operator new/delete (malloc/free); our C++17 plugins use aligned global new, and
   # shared_ptr<PointCloud> disposal resolves to libpcl's C++14 instantiation -> "operator new vs
   # free" in pcl_voxel's exportMap. Benign with glibc; every other ASan check stays on.
+  # --repeat until-pass:2: LeakSanitizer's tracer itself sometimes crashes at process exit ("Tracer
+  # caught signal 11 ... LeakSanitizer has encountered a fatal error") after a test has passed
+  # (seen on SyntheticTracking.AMapStartsOnUnconfirmed..., 1 of 3 runs, 2026-11-25); a real
+  # failure fails twice.
   ASAN_OPTIONS=detect_stack_use_after_return=1:check_initialization_order=1:alloc_dealloc_mismatch=0 \
   LSAN_OPTIONS=suppressions=$ROOT/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     nice -n 19 ctest --test-dir "$dir" -LE fuzz -E "${ASAN_EXCLUDE:-Quickly\$|WalkersStayOutOfPoseAndMap}" \
-      --output-on-failure -j1 ${CTEST_ARGS:-}
+      --output-on-failure -j1 --repeat until-pass:2 ${CTEST_ARGS:-}
 }
 
 run_tsan() {
