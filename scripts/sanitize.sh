@@ -4,7 +4,9 @@
 #   tsan: the threaded tests (tracking BA thread, mapping worker, visibility pass, CLI runs) under
 #         ThreadSanitizer, in build-tsan, with scripts/tsan.supp
 #   scripts/sanitize.sh [asan|tsan|all]   (default all)
-# Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, JOBS (compile jobs, default 2), CTEST_ARGS (extra).
+# Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, JOBS (compile jobs, default 2), TEST_JOBS (tests run at
+# once, default 2: half the wall time of one at a time on 2 cores; it also lets a signal land on
+# another thread, which is how TSan found the interrupt flag's race), CTEST_ARGS (extra).
 # Excluded under ASan (ASAN_EXCLUDE): the speed tests
 # SyntheticScene.RendersQuickly, MapPreview.WritesThreePngsAndRenders1500kPointsQuickly and
 # TrackerWithMotionFilter.TeddyDynDevFirst60FramesWalkersStayOutOfPoseAndMap (< 60 s) assert
@@ -49,7 +51,7 @@ run_asan() {
   LSAN_OPTIONS=suppressions=$ROOT/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     nice -n 19 ctest --test-dir "$dir" -LE fuzz -E "${ASAN_EXCLUDE:-Quickly\$|WalkersStayOutOfPoseAndMap}" \
-      --output-on-failure -j1 --repeat until-pass:2 ${CTEST_ARGS:-}
+      --output-on-failure -j"${TEST_JOBS:-2}" --repeat until-pass:2 ${CTEST_ARGS:-}
 }
 
 run_tsan() {
@@ -63,7 +65,8 @@ run_tsan() {
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
   nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|Visibility|AllBackends/VisibilityAllBackends|AllBackends/BackendContract|RunCommand|FaultInjection|Determinism)\\.}" \
-      -E "${TSAN_EXCLUDE:-RealtimeModeKeepsTrackingLagBounded}" --output-on-failure -j1 ${CTEST_ARGS:-}
+      -E "${TSAN_EXCLUDE:-RealtimeModeKeepsTrackingLagBounded}" --output-on-failure -j"${TEST_JOBS:-2}" \
+      ${CTEST_ARGS:-}
 }
 
 case "$WHAT" in
