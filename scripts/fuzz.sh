@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) into build-fuzz and runs each one for
-# N seconds (default 10: the CI smoke run; e.g. 600 for a long run), one after another, niced.
+# N seconds (default 10: the CI smoke run; e.g. 600 for a long run), TEST_JOBS (default 2) at
+# a time, niced (each target keeps a core for its N seconds).
 #   scripts/fuzz.sh [seconds-per-target]
 # Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-fuzz/fuzz/corpus/<target>/.
 # A crash leaves build-fuzz/fuzz/<target>-crash-* and makes the script fail; turn it into a
@@ -26,4 +27,4 @@ cmake -S . -B "$BUILD_DIR" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DDYNAMAP_FUZZ_SECONDS="$SECONDS_PER_TARGET" >/dev/null
 nice -n 19 cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target dynamap_fuzzers
 cd "$BUILD_DIR"
-nice -n 19 ctest -L fuzz --output-on-failure -j1
+nice -n 19 ctest -L fuzz --output-on-failure -j"${TEST_JOBS:-2}"
