@@ -20,8 +20,14 @@ import numpy as np
 
 
 def load_tum(path):
-    rows = [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
-    return np.array([[float(x) for x in r[:8]] for r in rows])
+    try:
+        rows = [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
+        table = np.array([[float(x) for x in r[:8]] for r in rows])
+    except (OSError, ValueError) as e:
+        sys.exit("motion_vs_gt.py: %s: %s" % (path, e))
+    if table.ndim != 2 or table.shape[1] != 8 or len(table) < 2:
+        sys.exit("motion_vs_gt.py: %s: expected two or more 'stamp tx ty tz qx qy qz qw' lines" % path)
+    return table
 
 
 def pose(row):
