@@ -3,60 +3,38 @@
 
 For each run (a `dynamap run` output folder), prints per frame the difference between the
 estimated relative motion (frame k-1 -> k) and the ground truth's, as a rotation angle (deg) and a
-translation (cm); these differences do not depend on how the trajectories are aligned. Two runs
+translation (cm): the TUM RPE with a delta of one frame, per pair (`dynamap evaluate --rpe-delta 1
+--rpe-unit f --rpe-pairs`); it does not depend on how the trajectories are aligned. Two runs
 of the same frames (e.g. the clean TUM sequence and a semi-synthetic one made from it) that
 differ from the ground truth by the same amounts at the same frames point at the ground truth,
 not at the tracking. With --masks SEQ the share of the standing person (mask value 128) that each
 keyframe mask of the first run (RUN/masks, `--save-masks`) covers is added.
 
 usage: scripts/motion_vs_gt.py GROUNDTRUTH RUN [RUN ...] [--masks SEQ] [--png OUT.png]
+       [--dynamap build/bin/dynamap]
 """
 import argparse
 import os
+import subprocess
 import sys
+import tempfile
 
 import cv2
 import numpy as np
 
 
-def load_tum(path):
-    try:
-        rows = [l.split() for l in open(path) if l.strip() and not l.startswith("#")]
-        table = np.array([[float(x) for x in r[:8]] for r in rows])
-    except (OSError, ValueError) as e:
-        sys.exit("motion_vs_gt.py: %s: %s" % (path, e))
-    if table.ndim != 2 or table.shape[1] != 8 or len(table) < 2:
-        sys.exit("motion_vs_gt.py: %s: expected two or more 'stamp tx ty tz qx qy qz qw' lines" % path)
-    return table
-
-
-def pose(row):
-    x, y, z, w = row[4:8]
-    n = np.sqrt(x * x + y * y + z * z + w * w)
-    x, y, z, w = x / n, y / n, z / n, w / n
-    m = np.eye(4)
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    m[:3, 3] = row[1:4]
-    return m
-
-
-def nearest(gt, t):
-    i = int(np.clip(np.searchsorted(gt[:, 0], t), 1, len(gt) - 1))
-    return gt[i] if abs(gt[i, 0] - t) < abs(gt[i - 1, 0] - t) else gt[i - 1]
-
-
-def motion_diffs(gt, est):
-    """{stamp: (rotation diff deg, translation diff cm)} for consecutive estimated frames."""
-    out = {}
-    for k in range(1, len(est)):
-        a = np.linalg.inv(pose(est[k - 1])) @ pose(est[k])
-        b = np.linalg.inv(pose(nearest(gt, est[k - 1, 0]))) @ pose(nearest(gt, est[k, 0]))
-        d = np.linalg.inv(a) @ b
-        angle = np.degrees(np.arccos(np.clip((np.trace(d[:3, :3]) - 1) / 2, -1, 1)))
-        out[round(est[k, 0], 3)] = (angle, 100 * np.linalg.norm(d[:3, 3]))
-    return out
+def motion_diffs(dynamap, groundtruth, run):
+    """{stamp of the later frame: (rotation diff deg, translation diff cm)}, from the project's
+    RPE (one frame apart, every pair)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        pairs = os.path.join(tmp, "pairs.txt")
+        cmd = [dynamap, "evaluate", "--gt", groundtruth, "--est", os.path.join(run, "trajectory.txt"),
+               "--rpe-delta", "1", "--rpe-unit", "f", "--rpe-pairs", pairs]
+        done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        if done.returncode != 0:
+            sys.exit("motion_vs_gt.py: %s" % (done.stderr.strip() or " ".join(cmd)))
+        rows = [l.split() for l in open(pairs) if l.strip() and not l.startswith("#")]
+    return {round(float(t), 3): (float(rot), 100 * float(trans)) for t, trans, rot in rows}
 
 
 def standing_share(seq, run):
@@ -109,9 +87,10 @@ def main():
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--masks", help="sequence folder with mask/ (standing person = 128)")
     ap.add_argument("--png")
+    ap.add_argument("--dynamap", default=os.path.join(os.path.dirname(__file__), "..", "build",
+                                                      "bin", "dynamap"))
     args = ap.parse_args()
-    gt = load_tum(args.groundtruth)
-    diffs = [motion_diffs(gt, load_tum(os.path.join(r, "trajectory.txt"))) for r in args.runs]
+    diffs = [motion_diffs(args.dynamap, args.groundtruth, r) for r in args.runs]
     bars = standing_share(args.masks, args.runs[0]) if args.masks else {}
     stamps = sorted(set.intersection(*(set(d) for d in diffs)))
     print("stamp " + " ".join("rot_deg%d trans_cm%d" % (i, i) for i in range(len(diffs))) +

@@ -224,6 +224,31 @@ TEST(TrajectoryEval, RpeMeasuresKnownDrift) {
   EXPECT_LT(r.rot_deg.rmse, 1e-5);
 }
 
+TEST(TrajectoryEval, RpeKeepsEveryPairAndItsStatsComeFromThem) {
+  // Straight line at 0.10 m/s (gt) vs 0.11 m/s (est), one frame apart: 1/3 mm per pair.
+  std::vector<TimedPose> gt, est;
+  for (int k = 0; k < 60; ++k) {
+    const double t = k / 30.0;
+    Eigen::Isometry3d G = Eigen::Isometry3d::Identity(), E = G;
+    G.translation().x() = 0.10 * t;
+    E.translation().x() = 0.11 * t;
+    gt.push_back({t, G});
+    est.push_back({t, E});
+  }
+  TrajectoryEvalOptions frames;
+  frames.rpe_unit = RpeDeltaUnit::kFrames;
+  const RpeResult r = computeRpe(gt, est, frames);
+  ASSERT_EQ(r.timestamps_s.size(), r.pairs);
+  ASSERT_EQ(r.trans_errors_m.size(), r.pairs);
+  ASSERT_EQ(r.rot_errors_deg.size(), r.pairs);
+  EXPECT_NEAR(r.timestamps_s.front(), 1.0 / 30.0, 1e-12);  // the later pose of the first pair
+  for (std::size_t i = 0; i < r.pairs; ++i) {
+    EXPECT_NEAR(r.trans_errors_m[i], 0.01 / 30.0, 1e-9);
+    EXPECT_LT(r.rot_errors_deg[i], 1e-5);
+  }
+  EXPECT_NEAR(computeErrorStats(r.trans_errors_m).rmse, r.trans_m.rmse, 1e-12);
+}
+
 TEST(TrajectoryEval, NoOverlapIsAnErrorAndShortRunHasNoRpePairs) {
   const auto gt = syntheticTrajectory(100, 5);
   std::vector<TimedPose> est = gt;

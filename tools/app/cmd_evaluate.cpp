@@ -1,7 +1,10 @@
 // dynamap evaluate: ATE/RPE of an estimated trajectory against ground truth, as the TUM
 // RGB-D benchmark scripts compute them.
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "commands.hpp"
@@ -20,7 +23,22 @@ struct EvaluateArgs {
   std::string align = "se3";
   double rpe_delta = 1.0;
   std::string rpe_unit = "s";
+  std::string rpe_pairs_path;
 };
+
+/// One line per RPE pair: the later pose's stamp, translation (m) and rotation (deg) error.
+void writeRpePairs(const std::string& path, const RpeResult& rpe) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  out << "# stamp_s trans_error_m rot_error_deg (RPE, delta " << rpe.delta
+      << (rpe.unit == RpeDeltaUnit::kFrames ? " frames" : " s") << ")\n";
+  out << std::fixed;
+  for (std::size_t i = 0; i < rpe.timestamps_s.size(); ++i) {
+    out << std::setprecision(6) << rpe.timestamps_s[i] << ' ' << std::setprecision(6)
+        << rpe.trans_errors_m[i] << ' ' << rpe.rot_errors_deg[i] << '\n';
+  }
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
 
 int runEvaluate(const EvaluateArgs& args) {
   TrajectoryEvalOptions options;
@@ -39,6 +57,7 @@ int runEvaluate(const EvaluateArgs& args) {
   if (!args.plot_path.empty()) {
     writeTrajectoryPlot(args.plot_path, gt, evaluation.ate);
   }
+  if (!args.rpe_pairs_path.empty()) writeRpePairs(args.rpe_pairs_path, evaluation.rpe);
   if (args.json) {
     std::cout << evaluationToJson(evaluation) << "\n";
   } else {
@@ -69,6 +88,8 @@ void addEvaluateCommand(CLI::App& app, int* exit_code) {
   cmd->add_option("--rpe-unit", args->rpe_unit, "RPE delta unit: s (seconds) or f (frames)")
       ->check(CLI::IsMember({"s", "f"}))
       ->capture_default_str();
+  cmd->add_option("--rpe-pairs", args->rpe_pairs_path,
+                  "write every RPE pair (stamp, translation m, rotation deg) to this file");
   cmd->callback([args, exit_code] { *exit_code = runEvaluate(*args); });
 }
 

@@ -207,8 +207,8 @@ RpeResult computeRpe(const std::vector<TimedPose>& gt_in, const std::vector<Time
   RpeResult r;
   r.delta = options.rpe_delta;
   r.unit = options.rpe_unit;
-  std::vector<double> trans_errors;
-  std::vector<double> rot_errors;
+  std::vector<double>& trans_errors = r.trans_errors_m;
+  std::vector<double>& rot_errors = r.rot_errors_deg;  // radians until the end
   if (!gt.empty() && !est.empty()) {
     const std::vector<double> stamps_gt = stampsOf(gt);
     const std::vector<double> stamps_est = stampsOf(est);
@@ -234,6 +234,7 @@ RpeResult computeRpe(const std::vector<TimedPose>& gt_in, const std::vector<Time
       }
       const Eigen::Isometry3d error =
           relativeError(est[i].T_W_C, est[j].T_W_C, gt[g_i].T_W_C, gt[g_j].T_W_C, scale);
+      r.timestamps_s.push_back(stamps_est[j]);
       trans_errors.push_back(error.translation().norm());
       const double c = std::clamp((error.linear().trace() - 1.0) / 2.0, -1.0, 1.0);
       rot_errors.push_back(std::acos(c));
@@ -246,6 +247,7 @@ RpeResult computeRpe(const std::vector<TimedPose>& gt_in, const std::vector<Time
                     &r.rot_deg.min, &r.rot_deg.max}) {
     *v *= kRadToDeg;
   }
+  for (double& v : rot_errors) v *= kRadToDeg;
   return r;
 }
 

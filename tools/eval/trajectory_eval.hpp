@@ -74,6 +74,10 @@ struct RpeResult {
   RpeDeltaUnit unit = RpeDeltaUnit::kSeconds;
   ErrorStats trans_m;
   ErrorStats rot_deg;
+  // Per pair, in the estimate's order:
+  std::vector<double> timestamps_s;    ///< the estimated stamp of the pair's later pose
+  std::vector<double> trans_errors_m;  ///< translation of the relative-motion error
+  std::vector<double> rot_errors_deg;  ///< its rotation angle
 };
 
 struct TrajectoryEvaluation {
