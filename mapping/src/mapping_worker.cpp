@@ -136,32 +136,39 @@ void MappingWorker::applyUpdateLocked(const PoseUpdate& update) {
     return;
   }
   it->second.T_current = update.T_W_C;
-  backend_->updatePose(update.keyframe_id, update.T_W_C);
+  if (!deferred()) backend_->updatePose(update.keyframe_id, update.T_W_C);
 }
 
 void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask) {
-  ScopedStageTimer timer(timings_, "mapping_integrate");
+  ScopedStageTimer timer(timings_, deferred() ? "mapping_keyframe" : "mapping_integrate");
   cv::Mat mask = kf.dynamic_mask;
   if (!extra_mask.empty() && cv::countNonZero(extra_mask) > 0) {
     mask = mask.empty() ? extra_mask : cv::max(mask, extra_mask);
   }
-  StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, mask, options_);
-  KeyframeView view;
-  view.id = kf.id;
-  view.timestamp_s = kf.timestamp_s;
-  view.T_W_C = kf.T_W_C;
-  view.camera = &camera_;
-  view.bgr = &kf.bgr;
-  view.static_depth_m = &sp.static_depth_m;
-  view.points_C = &sp.points_C;
-  view.colors = &sp.colors;
-  backend_->integrate(view);
   KeyframeRecord rec;
   rec.timestamp_s = kf.timestamp_s;
   rec.T_integrated = kf.T_W_C;
   rec.T_current = kf.T_W_C;
+  cv::Mat static_depth_m;
+  if (deferred()) {
+    static_depth_m = staticDepth(kf.depth_m, mask, options_);
+  } else {
+    StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, mask, options_);
+    KeyframeView view;
+    view.id = kf.id;
+    view.timestamp_s = kf.timestamp_s;
+    view.T_W_C = kf.T_W_C;
+    view.camera = &camera_;
+    view.bgr = &kf.bgr;
+    view.static_depth_m = &sp.static_depth_m;
+    view.points_C = &sp.points_C;
+    view.colors = &sp.colors;
+    backend_->integrate(view);
+    ++live_integrated_;
+    static_depth_m = sp.static_depth_m;
+  }
   if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate || options_.visibility.enabled) {
-    sp.static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
+    static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
     rec.bgr = kf.bgr;  // shared, immutable packet data
   }
   if (options_.visibility.enabled)
@@ -205,7 +212,7 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   }
   if (!moved) return;
   ScopedStageTimer timer(timings_, "mapping_rebuild");
-  backend_->reset();
+  if (live_integrated_ > 0) backend_->reset();
   // Keyframes are integrated in their order on this thread while the next one's points are made
   // on the other (it reads only its own record).
   const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
@@ -225,7 +232,12 @@ void MappingWorker::rebuildIfNeeded(bool force) {
     view.static_depth_m = &sp.static_depth_m;
     view.points_C = &sp.points_C;
     view.colors = &sp.colors;
-    backend_->integrate(view);
+    if (deferred()) {
+      ScopedStageTimer timer(timings_, "mapping_integrate");  // the backend's cost per keyframe
+      backend_->integrate(view);
+    } else {
+      backend_->integrate(view);
+    }
     rec.T_integrated = rec.T_current;
   };
   StaticPoints sp[2];
@@ -259,7 +271,8 @@ void MappingWorker::finish() {
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   for (const auto& u : late) applyUpdateLocked(u);
-  rebuildIfNeeded(removeSeenThroughLocked());
+  const bool removed = removeSeenThroughLocked();
+  rebuildIfNeeded(removed || deferred());
 }
 
 void MappingWorker::exportMap(const std::string& dir) {

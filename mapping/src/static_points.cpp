@@ -60,9 +60,8 @@ void backProjectDepth(const PinholeCamera& camera, const cv::Mat& bgr, const cv:
   }
 }
 
-StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr,
-                                 const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
-                                 const StaticPointsOptions& options) {
+cv::Mat staticDepth(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                    const StaticPointsOptions& options) {
   if (depth_m.type() != CV_32FC1) throw MappingError("extractStaticPoints: depth must be CV_32FC1");
   const bool has_mask = !dynamic_mask.empty();
   if (has_mask && (dynamic_mask.type() != CV_8UC1 || dynamic_mask.size() != depth_m.size())) {
@@ -73,11 +72,10 @@ StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr
   const auto z_max = static_cast<float>(options.depth_max_m);
   const auto edge = static_cast<float>(options.depth_edge_threshold_m);
 
-  StaticPoints out;
-  out.static_depth_m = cv::Mat::zeros(depth_m.size(), CV_32FC1);
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_32FC1);
   for (int r = 0; r < depth_m.rows; ++r) {
     const float* in = depth_m.ptr<float>(r);
-    float* dst = out.static_depth_m.ptr<float>(r);
+    float* dst = out.ptr<float>(r);
     const std::uint8_t* m = has_mask ? moving.ptr<std::uint8_t>(r) : nullptr;
     for (int c = 0; c < depth_m.cols; ++c) {
       const float z = in[c];
@@ -87,6 +85,14 @@ StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr
       dst[c] = z;
     }
   }
+  return out;
+}
+
+StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr,
+                                 const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                                 const StaticPointsOptions& options) {
+  StaticPoints out;
+  out.static_depth_m = staticDepth(depth_m, dynamic_mask, options);
   backProjectDepth(camera, bgr, out.static_depth_m, options.stride, &out.points_C, &out.colors);
   return out;
 }

@@ -58,7 +58,8 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   FakeLog log;
   TimingRecorder timings;
   StaticPointsOptions options;
-  options.free_space.enabled = false;  // integrate on arrival (no neighbour window)
+  options.free_space.enabled = false;    // integrate on arrival (no neighbour window)
+  options.deferred_integration = false;  // ... as each keyframe arrives
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
                        SyntheticScene::camera(), options, 1, &timings);
   worker.push(packet(1));  // taken by the worker thread, which blocks in integrate()
@@ -117,8 +118,10 @@ TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
   for (const double dx : {0.001, 0.05}) {
     FakeLog log;
     log.released = true;
+    StaticPointsOptions options;
+    options.deferred_integration = false;
     MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
-                         SyntheticScene::camera(), StaticPointsOptions{}, 4, nullptr);
+                         SyntheticScene::camera(), options, 4, nullptr);
     std::vector<PoseUpdate> updates;
     for (std::uint64_t id = 0; id < 3; ++id) {
       const auto kf = packet(id);
@@ -136,6 +139,50 @@ TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
       EXPECT_EQ(log.points[3], log.points[0]);  // same static points from the stored depth
     }
   }
+}
+
+// Deferred integration (the default with the visibility pass on): the backend gets each keyframe
+// exactly once, in finish(), with its final pose, and never a reset; with it off, the same pose
+// updates cost a second integration of every keyframe after a reset.
+TEST(MappingWorker, DeferredIntegrationIntegratesEachKeyframeOnceWithItsFinalPose) {
+  std::vector<std::size_t> points[2];  // [live, deferred]: points per keyframe
+  for (const bool deferred : {true, false}) {
+    FakeLog log;
+    log.released = true;
+    TimingRecorder timings;
+    StaticPointsOptions options;
+    options.deferred_integration = deferred;
+    MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
+                         SyntheticScene::camera(), options, 4, &timings);
+    std::vector<PoseUpdate> updates;
+    for (std::uint64_t id = 0; id < 4; ++id) {
+      const auto kf = packet(id);
+      worker.push(kf);
+      updates.push_back({id, Eigen::Translation3d(0.05, 0, 0) * kf->T_W_C});
+    }
+    worker.applyPoseUpdates(updates);
+    worker.finish();
+    if (deferred) {
+      EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3}));
+      EXPECT_EQ(log.resets, 0);
+      EXPECT_EQ(timings.stats("mapping_keyframe").count, 4u);
+    } else {
+      EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3, 0, 1, 2, 3}));
+      EXPECT_EQ(log.resets, 1);
+      EXPECT_EQ(timings.stats("mapping_keyframe").count, 0u);
+    }
+    // One timed backend integration per keyframe either way (deferred: those of finish()).
+    EXPECT_EQ(timings.stats("mapping_integrate").count, 4u);
+    for (const auto& u : updates) EXPECT_TRUE(log.poses.at(u.keyframe_id).isApprox(u.T_W_C));
+    // Points from the stored static depth: as many as the live integration got on arrival.
+    ASSERT_GE(log.points.size(), 4u);
+    points[deferred ? 1 : 0].assign(log.points.end() - 4, log.points.end());
+    if (!deferred) {
+      EXPECT_EQ(points[0], std::vector<std::size_t>(log.points.begin(), log.points.begin() + 4));
+    }
+  }
+  EXPECT_EQ(points[1], points[0]);
+  EXPECT_GT(points[1].front(), 1000u);
 }
 
 }  // namespace

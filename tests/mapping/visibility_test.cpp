@@ -6,6 +6,7 @@
 // is never masked and never moves (a standing person): it must stay.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "dynamap/mapping/ply_io.hpp"
@@ -100,6 +101,23 @@ TEST_P(VisibilityAllBackends, WithoutTheVisibilityPassTheMoverStays) {
   options.visibility.enabled = false;
   const auto map = buildMap(backend, options, false, "off");
   EXPECT_GT(ghostPoints(map, backendCase(backend).voxel_m), 0u) << backend;
+}
+
+// Deferred integration (the default) hands the backend the keyframes only in finish(): the
+// export is the one of integrating them on arrival as well (then rebuilt), point for point.
+TEST_P(VisibilityAllBackends, DeferredIntegrationExportsTheSameMap) {
+  const std::string backend = GetParam();
+  StaticPointsOptions live;
+  live.deferred_integration = false;
+  auto a = buildMap(backend, live, false, "live");
+  auto b = buildMap(backend, StaticPointsOptions{}, false, "deferred");
+  const auto by_xyz = [](const Eigen::Vector3f& p, const Eigen::Vector3f& q) {
+    return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+  };
+  std::sort(a.begin(), a.end(), by_xyz);
+  std::sort(b.begin(), b.end(), by_xyz);
+  ASSERT_GT(a.size(), 100u);
+  EXPECT_TRUE(a == b) << backend << ": " << a.size() << " vs " << b.size() << " points";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllBackends, VisibilityAllBackends, ::testing::ValuesIn(backendNames()),

@@ -29,8 +29,10 @@ namespace dynamap {
 /// checks every map element against every keyframe with the final poses (removeSeenThrough():
 /// what any keyframe saw through is removed) and rebuilds the map without it, whatever the
 /// backend; for that it keeps every keyframe's static depth, colour and a 1/downsample
-/// resolution view of its depth (VisibilityView). All public methods are thread-safe;
-/// exportMap() and stats() after finish() see the final map.
+/// resolution view of its depth (VisibilityView); and with options.deferred_integration (the
+/// default) the backend sees the keyframes only then, after the pass, with the final poses: the
+/// mapping thread keeps their static depth and views while the camera runs. All public methods are
+/// thread-safe; exportMap() and stats() after finish() see the final map.
 class MappingWorker {
  public:
   static constexpr double kReintegrateTranslationM = 0.01;
@@ -82,6 +84,8 @@ class MappingWorker {
   /// The visibility pass over all keyframes; true if it removed pixels.
   bool removeSeenThroughLocked();
   void applyUpdateLocked(const PoseUpdate& update);
+  /// Keyframes go to the backend only in finish() (see the class comment).
+  bool deferred() const { return options_.visibility.enabled && options_.deferred_integration; }
 
   std::unique_ptr<MapBackend> backend_;
   PinholeCamera camera_;
@@ -104,6 +108,7 @@ class MappingWorker {
   std::vector<std::uint64_t> order_;
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
+  std::size_t live_integrated_ = 0;  ///< keyframes the backend got on arrival
   VisibilityResult visibility_;
   std::thread thread_;
 };

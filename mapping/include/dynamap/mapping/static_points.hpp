@@ -21,6 +21,11 @@ struct StaticPointsOptions {
   int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
   FreeSpaceOptions free_space;   ///< MappingWorker: drop pixels that violate neighbours' free space
   VisibilityOptions visibility;  ///< MappingWorker::finish(): drop what any keyframe saw through
+  /// MappingWorker with `visibility` enabled: keyframes reach the backend only in finish(), after
+  /// the visibility pass, with the final poses (that pass rebuilds the map from the stored
+  /// keyframes whenever it removes anything, so integrating them on arrival as well was work
+  /// thrown away). false: each keyframe is also integrated when it arrives.
+  bool deferred_integration = true;
 };
 
 /// The static part of one RGB-D keyframe. The only place where masks become map input.
@@ -38,6 +43,10 @@ struct StaticPoints {
 StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr,
                                  const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
                                  const StaticPointsOptions& options);
+
+/// The static_depth_m of extractStaticPoints() alone (no points). Thread-safe (pure function).
+cv::Mat staticDepth(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
+                    const StaticPointsOptions& options);
 
 /// Back-projects the non-zero pixels of an already filtered depth image (every `stride`-th pixel).
 void backProjectDepth(const PinholeCamera& camera, const cv::Mat& bgr, const cv::Mat& depth_m,
