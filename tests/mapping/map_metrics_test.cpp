@@ -50,6 +50,26 @@ TEST(PointIndex, MatchesBruteForce) {
   }
 }
 
+// A dense surface (a wall with a step) and queries from 0 to 3 m off it: the geometry of the
+// maps' far-off points, where the search must prune by its nodes' boxes to stay fast.
+TEST(PointIndex, MatchesBruteForceOnASurfaceFromAfar) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<Eigen::Vector3f> pts(20000);
+  for (auto& p : pts) {
+    const float x = 2 * u(rng), y = 2 * u(rng);
+    p = {x, y, x > 1.0f ? 0.3f : 0.0f};
+  }
+  const PointIndex index(pts);
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3f q(4 * u(rng) - 1, 4 * u(rng) - 1, 3 * u(rng) - 0.1f);
+    float best = 1e9f;
+    for (const auto& p : pts) best = std::min(best, (p - q).norm());
+    EXPECT_EQ(index.nearestDistance(q), best) << q.transpose();
+    EXPECT_EQ(index.nearestDistance(q, best + 0.09f), best);
+  }
+}
+
 TEST(MapMetrics, DefinitionsOnASyntheticPlane) {
   const auto refs = makeRefs(planeZ(0.0f, 0.01f), planeZ(0.5f, 0.01f));
   const MapMetrics same = computeMapMetrics(planeZ(0.0f, 0.01f), refs);

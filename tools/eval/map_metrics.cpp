@@ -54,15 +54,17 @@ PointIndex::PointIndex(std::vector<Eigen::Vector3f> points) : points_(std::move(
 std::uint32_t PointIndex::build(std::uint32_t begin, std::uint32_t end) {
   const auto id = static_cast<std::uint32_t>(nodes_.size());
   nodes_.emplace_back();
-  if (end - begin <= kLeafSize) {
-    nodes_[id].begin = begin;
-    nodes_[id].end = end;
-    return id;
-  }
   Eigen::Vector3f lo = points_[begin], hi = points_[begin];
   for (std::uint32_t i = begin; i < end; ++i) {
     lo = lo.cwiseMin(points_[i]);
     hi = hi.cwiseMax(points_[i]);
+  }
+  nodes_[id].lo = lo;
+  nodes_[id].hi = hi;
+  if (end - begin <= kLeafSize) {
+    nodes_[id].begin = begin;
+    nodes_[id].end = end;
+    return id;
   }
   int axis = 0;
   (hi - lo).maxCoeff(&axis);
@@ -70,20 +72,18 @@ std::uint32_t PointIndex::build(std::uint32_t begin, std::uint32_t end) {
   std::nth_element(
       points_.begin() + begin, points_.begin() + mid, points_.begin() + end,
       [axis](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a[axis] < b[axis]; });
-  const float split = points_[mid][axis];
   const std::uint32_t left = build(begin, mid);
   const std::uint32_t right = build(mid, end);
   nodes_[id].axis = axis;
-  nodes_[id].split = split;
   nodes_[id].left = left;
   nodes_[id].right = right;
   return id;
 }
 
-// Exact nearest neighbour with the distance from q to each visited cell tracked incrementally
-// (per-axis offsets), so that far queries prune whole subtrees.
-void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float cell_sq,
-                        Eigen::Vector3f& offsets, float* best_sq) const {
+// Exact nearest neighbour, nearer child first, a subtree pruned by the distance from q to the
+// bounding box of its points. (Bounds from the split planes alone are open on the cells' other
+// sides: a query far from the cloud then scanned much of it, 3 s of a crowd map's metrics.)
+void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float* best_sq) const {
   const Node& n = nodes_[node];
   if (n.axis < 0) {
     for (std::uint32_t i = n.begin; i < n.end; ++i) {
@@ -91,25 +91,22 @@ void PointIndex::search(std::uint32_t node, const Eigen::Vector3f& q, float cell
     }
     return;
   }
-  const float diff = q[n.axis] - n.split;
-  const std::uint32_t near = diff < 0 ? n.left : n.right;
-  const std::uint32_t far = diff < 0 ? n.right : n.left;
-  search(near, q, cell_sq, offsets, best_sq);
-  const float old = offsets[n.axis];
-  const float far_sq = cell_sq - old * old + diff * diff;
-  if (far_sq < *best_sq) {
-    offsets[n.axis] = diff;
-    search(far, q, far_sq, offsets, best_sq);
-    offsets[n.axis] = old;
-  }
+  const auto box_sq = [&](std::uint32_t child) {
+    const Node& c = nodes_[child];
+    return (c.lo - q).cwiseMax(q - c.hi).cwiseMax(0.0f).squaredNorm();
+  };
+  std::uint32_t first = n.left, second = n.right;
+  float first_sq = box_sq(first), second_sq = box_sq(second);
+  if (second_sq < first_sq) std::swap(first, second), std::swap(first_sq, second_sq);
+  if (first_sq < *best_sq) search(first, q, best_sq);
+  if (second_sq < *best_sq) search(second, q, best_sq);
 }
 
 float PointIndex::nearestDistance(const Eigen::Vector3f& q, float max_distance) const {
   if (points_.empty()) return std::numeric_limits<float>::infinity();
   float best = std::isfinite(max_distance) ? max_distance * max_distance * 1.0001f
                                            : std::numeric_limits<float>::infinity();
-  Eigen::Vector3f offsets = Eigen::Vector3f::Zero();
-  search(0, q, 0.0f, offsets, &best);
+  search(0, q, &best);
   const float d = std::sqrt(best);
   return d <= max_distance ? d : std::numeric_limits<float>::infinity();
 }

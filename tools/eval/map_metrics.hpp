@@ -21,14 +21,13 @@ class PointIndex {
 
  private:
   struct Node {
-    int axis = -1;  ///< -1 = leaf
-    float split = 0.0f;
+    int axis = -1;                     ///< -1 = leaf (else the axis its points were split along)
     std::uint32_t begin = 0, end = 0;  ///< leaf range
     std::uint32_t left = 0, right = 0;
+    Eigen::Vector3f lo, hi;  ///< bounding box of its points
   };
   std::uint32_t build(std::uint32_t begin, std::uint32_t end);
-  void search(std::uint32_t node, const Eigen::Vector3f& q, float cell_sq, Eigen::Vector3f& offsets,
-              float* best_sq) const;
+  void search(std::uint32_t node, const Eigen::Vector3f& q, float* best_sq) const;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Node> nodes_;
 };
