@@ -2,7 +2,6 @@
 // map voxel key -> running centroid/colour (never re-filtering the whole map). For pose updates,
 // each keyframe also keeps its points reduced to voxel centroids (camera frame); a moved
 // keyframe marks the map dirty and export rebuilds the hash from those (cheap: reduced clouds).
-#include <algorithm>
 #include <unordered_map>
 
 #include <pcl/filters/statistical_outlier_removal.h>
@@ -10,6 +9,7 @@
 #include "dynamap/mapping/backend_params.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
 #include "pcl_cloud_io.hpp"
+#include "radix_sort.hpp"
 #include "voxel_key.hpp"
 
 namespace dynamap {
@@ -40,7 +40,7 @@ class PclVoxelBackend final : public MapBackend {
       p_W[i] = T * pts[i];
       keyed[i] = {plugin::voxelKey(p_W[i], inv_voxel_), static_cast<std::uint32_t>(i)};
     }
-    std::sort(keyed.begin(), keyed.end());
+    plugin::radixSortByKey(keyed, scratch_);
     Keyframe kf;
     kf.T_W_C = view.T_W_C;
     kf.T_integrated = view.T_W_C;
@@ -140,6 +140,7 @@ class PclVoxelBackend final : public MapBackend {
   int sor_k_ = 0;
   double sor_stddev_ = 1.0;
   VoxelMap map_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> scratch_;  ///< integrate()'s sort
   std::unordered_map<std::uint64_t, Keyframe> keyframes_;
   bool dirty_ = false;
 };
