@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/mapping/radix_sort.hpp"
 #include "in_two.hpp"
 
 namespace dynamap {
@@ -46,10 +47,10 @@ struct VoxelRun {
   std::uint64_t key = 0;
   std::uint32_t first = 0;
   std::uint32_t count = 0;
-  bool operator<(const VoxelRun& o) const { return key != o.key ? key < o.key : first < o.first; }
 };
 struct KeyedPoints {
   std::vector<VoxelRun> runs;
+  std::vector<VoxelRun> scratch;  ///< for the sort
   std::vector<Eigen::Vector3f> points;
 };
 
@@ -99,7 +100,8 @@ class ElementTable {
         out.runs.push_back({key, index, 1});
       }
     });
-    std::sort(out.runs.begin(), out.runs.end());
+    // Made in point order: a stable sort by voxel gives (key, first) order.
+    radixSortByKey(out.runs, out.scratch, [](const VoxelRun& r) { return r.key; });
   }
 
   /// Adds a keyframe's keyed points, point by point in (voxel, point) order: one hash access per

@@ -8,8 +8,8 @@
 
 #include "dynamap/mapping/backend_params.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
+#include "dynamap/mapping/radix_sort.hpp"
 #include "pcl_cloud_io.hpp"
-#include "radix_sort.hpp"
 #include "voxel_key.hpp"
 
 namespace dynamap {
@@ -40,7 +40,7 @@ class PclVoxelBackend final : public MapBackend {
       p_W[i] = T * pts[i];
       keyed[i] = {plugin::voxelKey(p_W[i], inv_voxel_), static_cast<std::uint32_t>(i)};
     }
-    plugin::radixSortByKey(keyed, scratch_);
+    radixSortByKey(keyed, scratch_, [](const auto& k) { return k.first; });
     Keyframe kf;
     kf.T_W_C = view.T_W_C;
     kf.T_integrated = view.T_W_C;

@@ -1,15 +1,16 @@
-// plugins/common/radix_sort.hpp: the order std::sort gives (key, index) pairs made in index order.
+// dynamap/mapping/radix_sort.hpp: the order std::sort gives (key, index) pairs made in index order.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 
-#include "radix_sort.hpp"
+#include "dynamap/mapping/radix_sort.hpp"
 
 namespace dynamap::test {
 namespace {
 
 using Pairs = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
+const auto first = [](const std::pair<std::uint64_t, std::uint32_t>& p) { return p.first; };
 
 Pairs indexed(const std::vector<std::uint64_t>& keys) {
   Pairs p(keys.size());
@@ -29,14 +30,14 @@ TEST(RadixSort, GivesStdSortsOrderForVoxelKeysWithManyDuplicates) {
     }
     Pairs expected = indexed(keys), got = indexed(keys);
     std::sort(expected.begin(), expected.end());
-    plugin::radixSortByKey(got, scratch);
+    radixSortByKey(got, scratch, first);
     EXPECT_EQ(got, expected) << spread;
   }
   Pairs empty;
-  plugin::radixSortByKey(empty, scratch);
+  radixSortByKey(empty, scratch, first);
   EXPECT_TRUE(empty.empty());
   Pairs extremes = indexed({~0ULL, 0ULL, ~0ULL, 1ULL << 63});
-  plugin::radixSortByKey(extremes, scratch);
+  radixSortByKey(extremes, scratch, first);
   EXPECT_EQ(extremes, (Pairs{{0ULL, 1}, {1ULL << 63, 3}, {~0ULL, 0}, {~0ULL, 2}}));
 }
 
