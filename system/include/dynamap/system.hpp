@@ -35,8 +35,10 @@ struct SystemCounts {
   std::size_t frames = 0;  ///< frames given to track() / mapWithPose() / markBadFrame()
   std::size_t tracked = 0, relocalized = 0, lost = 0, bad_frames = 0;
   std::size_t keyframes = 0;
-  std::size_t mapped_keyframes = 0;  ///< integrated by the backend (final after finish())
-  std::size_t mapper_dropped = 0;    ///< SystemOptions::drop_keyframes_when_busy only
+  /// Integrated by the backend: final after finish(); 0 before it with deferred integration
+  /// (mapping.deferred_integration, the default), where the backend gets them in finish().
+  std::size_t mapped_keyframes = 0;
+  std::size_t mapper_dropped = 0;  ///< SystemOptions::drop_keyframes_when_busy only
 };
 
 /// How a System is wired beyond the typed configuration.
