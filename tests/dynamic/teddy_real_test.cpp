@@ -7,6 +7,9 @@
 // regression, not on noise.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "../../tools/bench_dynamic/dynamic_harness.hpp"
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "test_paths.hpp"
@@ -58,6 +61,34 @@ TEST(TeddyDynDev, FusionMasksWalkersAndKeepsTheStandingPersonAndTheTeddy) {
   // what the naive baseline masks of it must be kept. (Issue 15 asks <= 10 %: not met. With the
   // detector run synchronously on each frame's own image it is 0.56 at input 256, 0.31 at 320.)
   EXPECT_LT(both.standing, 0.75 * naive.standing);
+}
+
+}  // namespace
+}  // namespace dynamap
+
+namespace dynamap {
+namespace {
+
+// The filter destroyed while its detector thread is still on a frame (a run that stops right
+// after handing a frame over): the destructor joins that thread before the filter's own members
+// go, so the frame's timing lands in live recorders only. Under AddressSanitizer
+// (scripts/sanitize.sh) the old member order failed here: heap-use-after-free in
+// TimingRecorder::add on the detector thread (the detection takes ~15-25 ms at 256 x 256; 10 ms
+// after the hand-over it is running on a 2-core machine). In other builds this only checks that
+// the destructor neither hangs nor records a frame twice.
+TEST(DynamicMotionFilter, DestroyedWhileItsDetectorRuns) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  DynamicConfig c;
+  resolveDynamicModelPaths(c, (test::sourceDir() / "config/default.yaml").string());
+  const dynbench::DynSequence seq(test::sharedData() / "dynamic/teddy_dyn_dev");
+  const dynbench::SequenceFrame frame = seq.load(20);
+  TimingRecorder timing;
+  {
+    DynamicMotionFilter filter(c, PinholeCamera{}, &timing);
+    filter.beginFrame(frame.frame);  // handed to the detector thread
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_LE(timing.stats("detector").count, 1u);
 }
 
 }  // namespace

@@ -173,7 +173,10 @@ DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config, const Pinh
   }
 }
 
-DynamicMotionFilter::~DynamicMotionFilter() = default;
+// The detector thread records its timings into own_timing_, declared after worker_: members die
+// in reverse order, so without this a detection still in flight wrote into a destroyed recorder
+// (AddressSanitizer, heap-use-after-free, TeddyDynDev.FusionMasksWalkers...).
+DynamicMotionFilter::~DynamicMotionFilter() { worker_.reset(); }
 
 void DynamicMotionFilter::record(const std::string& stage, double ms) {
   own_timing_.add(stage, ms);
