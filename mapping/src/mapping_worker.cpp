@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "in_two.hpp"
 
@@ -154,17 +155,7 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
     static_depth_m = staticDepth(kf.depth_m, mask, options_);
   } else {
     StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, mask, options_);
-    KeyframeView view;
-    view.id = kf.id;
-    view.timestamp_s = kf.timestamp_s;
-    view.T_W_C = kf.T_W_C;
-    view.camera = &camera_;
-    view.bgr = &kf.bgr;
-    view.static_depth_m = &sp.static_depth_m;
-    view.points_C = &sp.points_C;
-    view.colors = &sp.colors;
-    backend_->integrate(view);
-    ++live_integrated_;
+    backend_->integrate(keyframeView(kf.id, kf.timestamp_s, kf.T_W_C, camera_, kf.bgr, sp));
     static_depth_m = sp.static_depth_m;
   }
   if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate || options_.visibility.enabled) {
@@ -212,7 +203,7 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   }
   if (!moved) return;
   ScopedStageTimer timer(timings_, "mapping_rebuild");
-  if (live_integrated_ > 0) backend_->reset();
+  if (!deferred()) backend_->reset();  // deferred: the backend has had nothing yet
   // Keyframes are integrated in their order on this thread while the next one's points are made
   // on the other (it reads only its own record).
   const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
@@ -223,21 +214,9 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   };
   const auto integrate = [this](std::uint64_t id, const StaticPoints& sp) {
     KeyframeRecord& rec = records_.at(id);
-    KeyframeView view;
-    view.id = id;
-    view.timestamp_s = rec.timestamp_s;
-    view.T_W_C = rec.T_current;
-    view.camera = &camera_;
-    view.bgr = &rec.bgr;
-    view.static_depth_m = &sp.static_depth_m;
-    view.points_C = &sp.points_C;
-    view.colors = &sp.colors;
-    if (deferred()) {
-      ScopedStageTimer timer(timings_, "mapping_integrate");  // the backend's cost per keyframe
-      backend_->integrate(view);
-    } else {
-      backend_->integrate(view);
-    }
+    std::optional<ScopedStageTimer> timer;  // deferred: the backend's cost per keyframe
+    if (deferred()) timer.emplace(timings_, "mapping_integrate");
+    backend_->integrate(keyframeView(id, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
     rec.T_integrated = rec.T_current;
   };
   StaticPoints sp[2];

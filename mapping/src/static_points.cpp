@@ -88,6 +88,20 @@ cv::Mat staticDepth(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
   return out;
 }
 
+KeyframeView keyframeView(std::uint64_t id, double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                          const PinholeCamera& camera, const cv::Mat& bgr, const StaticPoints& sp) {
+  KeyframeView view;
+  view.id = id;
+  view.timestamp_s = timestamp_s;
+  view.T_W_C = T_W_C;
+  view.camera = &camera;
+  view.bgr = &bgr;
+  view.static_depth_m = &sp.static_depth_m;
+  view.points_C = &sp.points_C;
+  view.colors = &sp.colors;
+  return view;
+}
+
 StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr,
                                  const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
                                  const StaticPointsOptions& options) {

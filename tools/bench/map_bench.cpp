@@ -63,15 +63,7 @@ RunResult runBackend(const BackendRegistry& registry, const RunSpec& spec,
     const StaticPoints sp =
         extractStaticPoints(camera, lf.bgr, lf.depth_m, lf.dynamic_mask, options);
     static_ms.push_back(msSince(t0));
-    KeyframeView view;
-    view.id = f.id;
-    view.timestamp_s = f.timestamp_s;
-    view.T_W_C = f.T_W_C;
-    view.camera = &camera;
-    view.bgr = &lf.bgr;
-    view.static_depth_m = &sp.static_depth_m;
-    view.points_C = &sp.points_C;
-    view.colors = &sp.colors;
+    const KeyframeView view = keyframeView(f.id, f.timestamp_s, f.T_W_C, camera, lf.bgr, sp);
     t0 = std::chrono::steady_clock::now();
     backend->integrate(view);
     integrate_ms.push_back(msSince(t0));

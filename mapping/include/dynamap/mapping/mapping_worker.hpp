@@ -108,7 +108,6 @@ class MappingWorker {
   std::vector<std::uint64_t> order_;
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
-  std::size_t live_integrated_ = 0;  ///< keyframes the backend got on arrival
   VisibilityResult visibility_;
   std::thread thread_;
 };

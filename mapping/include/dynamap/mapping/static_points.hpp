@@ -9,6 +9,7 @@
 
 #include "dynamap/core/camera.hpp"
 #include "dynamap/mapping/free_space.hpp"
+#include "dynamap/mapping/map_backend.hpp"
 #include "dynamap/mapping/visibility.hpp"
 
 namespace dynamap {
@@ -47,6 +48,11 @@ StaticPoints extractStaticPoints(const PinholeCamera& camera, const cv::Mat& bgr
 /// The static_depth_m of extractStaticPoints() alone (no points). Thread-safe (pure function).
 cv::Mat staticDepth(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
                     const StaticPointsOptions& options);
+
+/// What a backend's integrate() reads of one keyframe: pointers into `camera`, `bgr` and `sp`,
+/// which must outlive the view.
+KeyframeView keyframeView(std::uint64_t id, double timestamp_s, const Eigen::Isometry3d& T_W_C,
+                          const PinholeCamera& camera, const cv::Mat& bgr, const StaticPoints& sp);
 
 /// Back-projects the non-zero pixels of an already filtered depth image (every `stride`-th pixel).
 void backProjectDepth(const PinholeCamera& camera, const cv::Mat& bgr, const cv::Mat& depth_m,
