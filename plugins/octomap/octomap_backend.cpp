@@ -1,8 +1,12 @@
 // `octomap`: occupancy octree with ray casting from the camera centre (free space clears
 // ghosts). Fast path: each keyframe's points are reduced to the centres of the distinct voxels
-// they hit before ray casting (lazy evaluation; inner nodes are updated at export).
+// they hit before ray casting (lazy evaluation; inner nodes are updated at export). The ray
+// casting of a keyframe runs on another thread while the previous keyframe's cells are updated
+// in the tree, in keyframe order (the same updates as insertPointCloud, the same map).
 // Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres).
 #include <filesystem>
+#include <future>
+#include <memory>
 #include <unordered_set>
 
 #include <octomap/OcTree.h>
@@ -17,7 +21,7 @@ namespace {
 
 class OctomapBackend final : public MapBackend {
  public:
-  explicit OctomapBackend(const BackendParams& params) : tree_(0.05) {
+  explicit OctomapBackend(const BackendParams& params) : tree_(0.05), caster_(0.05) {
     ParamReader reader("octomap", params);
     const double res = reader.getDouble("resolution_m", 0.05, 0.005, 10.0);
     max_range_m_ = reader.getDouble("max_range_m", -1.0, -1.0, 1000.0);
@@ -33,6 +37,7 @@ class OctomapBackend final : public MapBackend {
     grid_.max_height_m = reader.getDouble("grid_max_height_m", 2.0, -1e4, 1e4);
     reader.finish();
     tree_.setResolution(res);
+    caster_.setResolution(res);
     tree_.setProbHit(hit);
     tree_.setProbMiss(miss);
     tree_.setClampingThresMin(cmin);
@@ -58,8 +63,16 @@ class OctomapBackend final : public MapBackend {
         cloud.push_back(p.x(), p.y(), p.z());
       }
     }
-    tree_.insertPointCloud(cloud, octomap::point3d(o.x(), o.y(), o.z()), max_range_m_,
-                           /*lazy_eval=*/true, /*discretize=*/false);
+    // The caster is free once the previous keyframe's rays are in; its cells go into the tree
+    // while this keyframe's rays are cast.
+    std::unique_ptr<Cells> previous = pending_.valid() ? pending_.get() : nullptr;
+    pending_ = std::async(std::launch::async, [this, cloud = std::move(cloud),
+                                               origin = octomap::point3d(o.x(), o.y(), o.z())] {
+      auto cells = std::make_unique<Cells>();
+      caster_.computeUpdate(cloud, origin, cells->free, cells->occupied, max_range_m_);
+      return cells;
+    });
+    if (previous) apply(*previous);
     dirty_inner_ = true;
     ++keyframes_;
   }
@@ -67,6 +80,7 @@ class OctomapBackend final : public MapBackend {
   void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
   void reset() override {
+    if (pending_.valid()) pending_.get();
     tree_.clear();
     keyframes_ = 0;
   }
@@ -90,6 +104,7 @@ class OctomapBackend final : public MapBackend {
   }
 
   MapStats stats() const override {
+    drain();
     MapStats s;
     s.keyframes = keyframes_;
     for (auto it = tree_.begin_leafs(), end = tree_.end_leafs(); it != end; ++it) {
@@ -101,7 +116,19 @@ class OctomapBackend final : public MapBackend {
   }
 
  private:
+  struct Cells {
+    octomap::KeySet free, occupied;
+  };
+  /// insertPointCloud's updates: the free cells, then the occupied ones.
+  void apply(const Cells& cells) const {
+    for (const auto& key : cells.free) tree_.updateNode(key, false, /*lazy_eval=*/true);
+    for (const auto& key : cells.occupied) tree_.updateNode(key, true, /*lazy_eval=*/true);
+  }
+  void drain() const {
+    if (pending_.valid()) apply(*pending_.get());
+  }
   void finalizeTree() {
+    drain();
     if (dirty_inner_) tree_.updateInnerOccupancy();
     dirty_inner_ = false;
   }
@@ -124,7 +151,10 @@ class OctomapBackend final : public MapBackend {
     return out;
   }
 
-  octomap::OcTree tree_;
+  // The last keyframe's cells are applied when the map is next read, by const readers too.
+  mutable octomap::OcTree tree_;
+  octomap::OcTree caster_;  ///< casts rays only (its own key ray buffers), never holds a map
+  mutable std::future<std::unique_ptr<Cells>> pending_;
   double max_range_m_ = -1.0;
   bool discretize_ = true;
   plugin::GridOptions grid_;
