@@ -19,11 +19,14 @@
 namespace dynamap {
 namespace {
 
+constexpr double kDefaultResolutionM = 0.03;
+
 class OctomapBackend final : public MapBackend {
  public:
-  explicit OctomapBackend(const BackendParams& params) : tree_(0.03), caster_(0.03) {
+  explicit OctomapBackend(const BackendParams& params)
+      : tree_(kDefaultResolutionM), caster_(kDefaultResolutionM) {
     ParamReader reader("octomap", params);
-    const double res = reader.getDouble("resolution_m", 0.03, 0.005, 10.0);
+    const double res = reader.getDouble("resolution_m", kDefaultResolutionM, 0.005, 10.0);
     max_range_m_ = reader.getDouble("max_range_m", -1.0, -1.0, 1000.0);
     discretize_ = reader.getBool("discretize", true);
     const double hit = reader.getDouble("prob_hit", 0.7, 0.5, 1.0);

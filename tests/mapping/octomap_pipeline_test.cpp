@@ -7,27 +7,13 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include "dynamap/mapping/static_points.hpp"
 #include "mapping_test_utils.hpp"
 
 namespace dynamap {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// The static points of synthetic frame k (every other pixel with depth, mask 0), camera frame.
-std::vector<Eigen::Vector3f> staticPointsOf(const test::SyntheticFrame& f,
-                                            const PinholeCamera& cam) {
-  std::vector<Eigen::Vector3f> out;
-  for (int v = 0; v < f.depth_m.rows; v += 2) {
-    for (int u = 0; u < f.depth_m.cols; u += 2) {
-      const float z = f.depth_m.at<float>(v, u);
-      if (z <= 0.f || f.mask.at<std::uint8_t>(v, u) != 0) continue;
-      out.emplace_back(static_cast<float>((u - cam.cx) / cam.fx) * z,
-                       static_cast<float>((v - cam.cy) / cam.fy) * z, z);
-    }
-  }
-  return out;
-}
 
 TEST(OctomapBackend, PipelinedRayCastingGivesInsertPointCloudsMap) {
   const auto registry = BackendRegistry::scan({test::pluginDir()});
@@ -45,14 +31,12 @@ TEST(OctomapBackend, PipelinedRayCastingGivesInsertPointCloudsMap) {
   const int n = 8;
   for (int k = 0; k < n; ++k) {
     const test::SyntheticFrame f = scene.render(k, n);
-    const auto points = staticPointsOf(f, cam);
-    KeyframeView view;
-    view.id = static_cast<std::uint64_t>(k);
-    view.T_W_C = f.T_W_C;
-    view.camera = &cam;
-    view.bgr = &f.bgr;
-    view.points_C = &points;
-    backend->integrate(view);
+    StaticPointsOptions options;
+    options.stride = 2;
+    const StaticPoints sp = extractStaticPoints(cam, f.bgr, f.depth_m, f.mask, options);
+    const auto& points = sp.points_C;
+    backend->integrate(
+        keyframeView(static_cast<std::uint64_t>(k), 0.1 * k, f.T_W_C, cam, f.bgr, sp));
     if (k == n / 2) {  // a reader in between takes the cells still in flight
       EXPECT_EQ(backend->stats().keyframes, static_cast<std::size_t>(k + 1));
     }
