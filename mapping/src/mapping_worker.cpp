@@ -185,6 +185,7 @@ bool MappingWorker::removeSeenThroughLocked() {
     k.metres_per_unit = 1.0 / kDepthUnitsPerM;
     k.T_W_C = rec.T_current;
     k.view = &rec.view;
+    k.timestamp_s = rec.timestamp_s;
     keyframes.push_back(k);
   }
   visibility_ = removeSeenThrough(camera_, keyframes, options_.visibility);

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -39,6 +40,9 @@ struct Element {
   std::uint32_t seen_through = 0;
   std::uint16_t observed = 0;  ///< keyframes whose surface at the projection is this element
   std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
+  std::uint16_t in_view = 0;   ///< keyframes with a depth reading at its projection
+  std::uint32_t first = std::numeric_limits<std::uint32_t>::max();  ///< first observing keyframe
+  std::uint32_t last = 0;                                           ///< last observing keyframe
 };
 
 /// A keyframe's static points in runs of consecutive points of one voxel (neighbouring pixels of
@@ -79,6 +83,16 @@ void forEachStaticPoint(const PinholeCamera& camera, const VisibilityKeyframe& k
   } else {
     forEachStaticPointT<float>(camera, kf, fn);
   }
+}
+
+/// A mover that stood still for a moment (a foot during a step): some keyframe saw the element
+/// under its mask, every keyframe that saw it did so within options.mask_span_s, and many more
+/// had it in view (something else in front, or the surface behind it within the margin).
+bool briefUnderMask(const Element& e, const VisibilityOptions& options,
+                    const std::vector<double>& stamps) {
+  if (options.mask_span_s <= 0.0 || e.masked == 0 || e.last >= stamps.size()) return false;
+  return stamps[e.last] - stamps[e.first] <= options.mask_span_s &&
+         e.in_view >= options.mask_span_view_ratio * e.observed;
 }
 
 class ElementTable {
@@ -128,11 +142,11 @@ class ElementTable {
     }
   }
 
-  /// Counts, for the elements [begin, end), whether this view saw through them. Thread-safe for
-  /// disjoint ranges.
+  /// Counts, for the elements [begin, end), whether this view (keyframe `index`) saw through
+  /// them. Thread-safe for disjoint ranges.
   void project(const PinholeCamera& camera, const VisibilityView& view,
                const Eigen::Isometry3d& T_W_C, const VisibilityOptions& options, std::size_t begin,
-               std::size_t end) {
+               std::size_t end, std::uint32_t index) {
     const Eigen::Isometry3f T_C_W = T_W_C.inverse().cast<float>();
     const Eigen::Matrix3f R = T_C_W.linear();
     const Eigen::Vector3f t = T_C_W.translation();
@@ -154,10 +168,13 @@ class ElementTable {
       if (seen <= 0.0f) continue;
       const float m = margin + per_m2 * seen * seen;
       Element& e = elements_[i];
+      if (e.in_view < 0xffff) ++e.in_view;
       if (p.z() < seen - m) {
         if (e.seen_through < cap) ++e.seen_through;
       } else if (p.z() <= seen + m && e.observed < 0xffff) {
         ++e.observed;
+        e.first = std::min(e.first, index);
+        e.last = index;  // views come in keyframe order
         if (has_mask && view.moving.at<std::uint8_t>(static_cast<int>(vf), static_cast<int>(uf)))
           ++e.masked;
       }
@@ -165,15 +182,17 @@ class ElementTable {
   }
 
   /// Keys of the removed elements (a small set: fast lookups for every pixel); counts those
-  /// removed by mask votes only.
+  /// removed by mask votes only. stamps: the keyframes' times (s), in view order.
   std::unordered_set<std::uint64_t> removedKeys(const VisibilityOptions& options,
+                                                const std::vector<double>& stamps,
                                                 std::size_t* mask_voted) const {
     const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
     std::unordered_set<std::uint64_t> keys;
     for (const auto& [key, i] : index_) {
       const Element& e = elements_[i];
-      const bool voted = options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
-                         e.masked >= options.mask_ratio * e.observed;
+      const bool voted = (options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
+                          e.masked >= options.mask_ratio * e.observed) ||
+                         briefUnderMask(e, options, stamps);
       if (e.seen_through >= min_views || voted) keys.insert(key);
       if (e.seen_through < min_views && voted) ++*mask_voted;
     }
@@ -259,12 +278,15 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
       if (view == nullptr || view->near_m.empty()) continue;
       const auto t0 = Clock::now();
       table.project(camera, *view, keyframes[j].T_W_C, options, h == 0 ? 0 : half,
-                    h == 0 ? half : table.size());
+                    h == 0 ? half : table.size(), static_cast<std::uint32_t>(j));
       ms[h][j] += msSince(t0);
     }
   });
   result.elements = table.size();
-  const std::unordered_set<std::uint64_t> removed = table.removedKeys(options, &result.mask_voted);
+  std::vector<double> stamps(n);
+  for (std::size_t i = 0; i < n; ++i) stamps[i] = keyframes[i].timestamp_s;
+  const std::unordered_set<std::uint64_t> removed =
+      table.removedKeys(options, stamps, &result.mask_voted);
   result.seen_through = removed.size() - result.mask_voted;
   result.element_bytes = table.bytes();
   if (!removed.empty()) {

@@ -27,6 +27,8 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.visibility_margin_per_m2", &vis.margin_per_m2, 0.0, 10.0);
   schema.addInt("mapping.visibility_mask_min_views", &vis.mask_min_views, 0, 1000);
   schema.addDouble("mapping.visibility_mask_ratio", &vis.mask_ratio, 0.0, 1.0);
+  schema.addDouble("mapping.visibility_mask_span_s", &vis.mask_span_s, 0.0, 1e6);
+  schema.addDouble("mapping.visibility_mask_span_view_ratio", &vis.mask_span_view_ratio, 0.0, 1e6);
   schema.addBool("mapping.deferred_integration", &s.deferred_integration);
 }
 

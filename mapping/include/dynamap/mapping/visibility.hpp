@@ -22,6 +22,11 @@ struct VisibilityOptions {
   /// all the keyframes that saw it, is a mover one keyframe's mask missed.
   int mask_min_views = 2;
   double mask_ratio = 0.5;
+  /// Brief mask votes (0 = off): an element that one keyframe saw under its mask, that every
+  /// keyframe seeing it saw within mask_span_s (s), and that at least mask_span_view_ratio
+  /// times as many keyframes had in view, is a mover that stood still for a moment.
+  double mask_span_s = 0.7;
+  double mask_span_view_ratio = 2.0;
 };
 
 /// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
@@ -45,12 +50,13 @@ struct VisibilityKeyframe {
   double metres_per_unit = 1.0;     ///< depth scale (1 for metres, 1/5000 for TUM 16-bit)
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   const VisibilityView* view = nullptr;
+  double timestamp_s = 0.0;  ///< keyframes come in time order
 };
 
 struct VisibilityResult {
   std::size_t elements = 0;      ///< voxels of the map checked
   std::size_t seen_through = 0;  ///< of those, removed because some keyframe saw through them
-  std::size_t mask_voted = 0;    ///< removed by mask votes only
+  std::size_t mask_voted = 0;    ///< removed by mask votes (plain or brief) only
   std::size_t removed_pixels = 0;
   std::size_t element_bytes = 0;        ///< memory of the element table during the pass
   std::vector<double> per_keyframe_ms;  ///< cost of each keyframe (build + projection + removal)
@@ -62,7 +68,9 @@ struct VisibilityResult {
 /// through (the view's surface at its projection lies behind it by more than margin_m +
 /// margin_per_m2 * z^2) was not there at that time: its pixels are set to 0 in every
 /// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
-/// dynamic mask (options.mask_min_views, mask_ratio). Anything that every visit saw (a
+/// dynamic mask (options.mask_min_views, mask_ratio), and one that a keyframe saw under its mask
+/// and all keyframes saw only within a short time (options.mask_span_s, mask_span_view_ratio;
+/// keyframes must come in time order). Anything that every visit saw (a
 /// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
 /// point pairs. Runs on two threads (keyframes keyed two at a time and added in their order,
 /// elements split in halves, removal split by keyframe): the result does not depend on the
