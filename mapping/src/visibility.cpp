@@ -12,6 +12,7 @@
 
 #include "dynamap/mapping/radix_sort.hpp"
 #include "in_two.hpp"
+#include "plane_fit.hpp"
 
 namespace dynamap {
 namespace {
@@ -94,6 +95,8 @@ bool briefUnderMask(const Element& e, const VisibilityOptions& options,
   return stamps[e.last] - stamps[e.first] <= options.mask_span_s &&
          e.in_view >= options.mask_span_view_ratio * e.observed;
 }
+
+constexpr float kSupportRadiusM = 0.12f;  ///< onConfirmedPlane(): neighbourhood (cube half side)
 
 class ElementTable {
  public:
@@ -186,19 +189,62 @@ class ElementTable {
   std::unordered_set<std::uint64_t> removedKeys(const VisibilityOptions& options,
                                                 const std::vector<double>& stamps,
                                                 std::size_t* mask_voted) const {
-    const auto min_views = static_cast<std::uint32_t>(std::max(1, options.min_views));
     std::unordered_set<std::uint64_t> keys;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> brief;
     for (const auto& [key, i] : index_) {
       const Element& e = elements_[i];
-      const bool voted = (options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
-                          e.masked >= options.mask_ratio * e.observed) ||
-                         briefUnderMask(e, options, stamps);
-      if (e.seen_through >= min_views || voted) keys.insert(key);
-      if (e.seen_through < min_views && voted) ++*mask_voted;
+      if (seenThrough(e, options) || plainVote(e, options)) {
+        keys.insert(key);
+        if (!seenThrough(e, options)) ++*mask_voted;
+      } else if (briefUnderMask(e, options, stamps)) {
+        brief.emplace_back(key, i);
+      }
+    }
+    std::vector<Eigen::Vector3f> support;
+    for (const auto& [key, i] : brief) {
+      if (onConfirmedPlane(key, i, options, stamps, support)) continue;
+      keys.insert(key);
+      ++*mask_voted;
     }
     return keys;
   }
   std::uint64_t key(const Eigen::Vector3f& p_W) const { return voxelKey(p_W, inv_voxel_); }
+  static bool seenThrough(const Element& e, const VisibilityOptions& options) {
+    return e.seen_through >= static_cast<std::uint32_t>(std::max(1, options.min_views));
+  }
+  static bool plainVote(const Element& e, const VisibilityOptions& options) {
+    return options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
+           e.masked >= options.mask_ratio * e.observed;
+  }
+
+  /// Whether element i lies on a plane that the elements around it (within kSupportRadiusM)
+  /// confirm, those seen over more than mask_span_s and kept: the floor that a mask took with a
+  /// foot stays, the foot above it does not (nor the rest of a flat mover, seen as briefly).
+  bool onConfirmedPlane(std::uint64_t key, std::uint32_t i, const VisibilityOptions& options,
+                        const std::vector<double>& stamps,
+                        std::vector<Eigen::Vector3f>& support) const {
+    const int reach = std::max(1, static_cast<int>(std::lround(kSupportRadiusM * inv_voxel_)));
+    constexpr std::uint64_t kMask = (1u << 21) - 1;
+    support.clear();
+    for (int dz = -reach; dz <= reach; ++dz) {
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
+          const auto shift = [&](int axis, int d) {
+            return ((((key >> (21 * axis)) & kMask) + static_cast<std::uint64_t>(d)) & kMask)
+                   << (21 * axis);
+          };
+          const auto it = index_.find(shift(0, dx) | shift(1, dy) | shift(2, dz));
+          if (it == index_.end() || it->second == i) continue;
+          const Element& s = elements_[it->second];
+          const bool long_seen = s.observed >= 2 && s.last < stamps.size() &&
+                                 stamps[s.last] - stamps[s.first] > options.mask_span_s;
+          if (!long_seen || seenThrough(s, options) || plainVote(s, options)) continue;
+          support.push_back(centroids_[it->second]);
+        }
+      }
+    }
+    return liesOnPlane(support, centroids_[i]);
+  }
   std::size_t size() const { return elements_.size(); }
   std::size_t bytes() const {
     const std::size_t node = sizeof(std::uint64_t) + sizeof(std::uint32_t) + 2 * sizeof(void*);

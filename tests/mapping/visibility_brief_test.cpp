@@ -19,12 +19,22 @@ constexpr double kPeriodS = 0.1;  // keyframes 10 Hz apart
 
 const Box kFoot = SyntheticScene::movingBox(0);
 
-/// A box halfway between camera k and the foot, as large as the foot: it hides the foot.
-Box occluderFor(int k) {
+/// A mat on the floor, 3 mm thick, where a mask took the floor with a foot.
+const Box kMat{{-0.5, -0.4, 0.0}, {-0.2, -0.1, 0.003}};
+
+/// `hidden` shrunk halfway towards camera k (bounding box of its corners): it hides `hidden`
+/// and little else.
+Box occluderFor(int k, const Box& hidden) {
   const Eigen::Vector3d eye = SyntheticScene::pose(k, kKeyframes).translation();
-  const Eigen::Vector3d half = 0.5 * (kFoot.hi - kFoot.lo);
-  const Eigen::Vector3d mid = 0.5 * (eye + 0.5 * (kFoot.lo + kFoot.hi));
-  return Box{mid - half, mid + half};
+  Box b{Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(-1e9)};
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner((c & 1) ? hidden.hi.x() : hidden.lo.x(),
+                                 (c & 2) ? hidden.hi.y() : hidden.lo.y(),
+                                 (c & 4) ? hidden.hi.z() : hidden.lo.z());
+    const Eigen::Vector3d p = eye + 0.5 * (corner - eye);
+    b.lo = b.lo.cwiseMin(p), b.hi = b.hi.cwiseMax(p);
+  }
+  return b;
 }
 
 struct Pass {
@@ -33,16 +43,19 @@ struct Pass {
   VisibilityResult result;
 };
 
-/// Keyframes 0-2 see the foot (keyframe 1 masks it); the others see the occluder (masked),
-/// except those in `seen_again`, which see the foot unmasked.
-Pass run(const VisibilityOptions& options, const std::vector<int>& seen_again) {
+/// Keyframes 0-2 see `foot_box` (keyframe 1 masks it); the others see an occluder (masked) in
+/// front of `hidden` (default: the whole foot), except those in `seen_again`, which see the foot
+/// unmasked.
+Pass run(const VisibilityOptions& options, const std::vector<int>& seen_again,
+         const Box& foot_box = kFoot, const Box* hidden = nullptr) {
   const SyntheticScene scene;
   Pass p;
   std::vector<VisibilityView> views;
   std::vector<cv::Mat> masks;
   for (int k = 0; k < kKeyframes; ++k) {
     const bool foot = k < 3 || std::count(seen_again.begin(), seen_again.end(), k) > 0;
-    p.frames.push_back(scene.render(k, kKeyframes, foot ? kFoot : occluderFor(k)));
+    p.frames.push_back(
+        scene.render(k, kKeyframes, foot ? foot_box : occluderFor(k, hidden ? *hidden : foot_box)));
     const SyntheticFrame& f = p.frames.back();
     masks.push_back(foot && k != 1 ? cv::Mat::zeros(f.mask.size(), CV_8UC1) : f.mask);
     p.depths.push_back(f.depth_m.clone());
@@ -106,6 +119,25 @@ TEST(VisibilityBrief, WhatLaterVisitsSeeAgainStays) {
   const Pass p = run(withSpan(0.7), {8, 9});
   EXPECT_LT(footRemoved(p, 0), 0.1);
   EXPECT_LT(footRemoved(p, 8), 0.1);
+}
+
+// A patch of floor that a mask took with a foot (the mat, masked in keyframe 1) and whose middle
+// later views never see again (someone in front) lies on the plane of the floor around it, which
+// every visit saw: it stays but for a few voxels at the edge of that middle (10 % of the mat's
+// pixels here; 59 % go without the plane test). The same mat raised 15 cm off the floor, with
+// nothing around it that later visits confirm, goes (58 %).
+TEST(VisibilityBrief, FloorTakenWithAFootStays) {
+  const Eigen::Vector3d mid = 0.5 * (kMat.lo + kMat.hi), quarter = 0.25 * (kMat.hi - kMat.lo);
+  const Box middle{mid - quarter, mid + quarter};
+  const Pass on_floor = run(withSpan(0.7), {}, kMat, &middle);
+  ASSERT_GT(cv::countNonZero(on_floor.frames[0].mask), 200);
+  EXPECT_LT(footRemoved(on_floor, 0), 0.2);
+  EXPECT_LT(footRemoved(on_floor, 2), 0.2);
+  const Eigen::Vector3d up(0.0, 0.0, 0.15);
+  const Box raised{kMat.lo + up, kMat.hi + up}, raised_middle{middle.lo + up, middle.hi + up};
+  const Pass off_floor = run(withSpan(0.7), {}, raised, &raised_middle);
+  EXPECT_GT(footRemoved(off_floor, 0), 0.4);
+  EXPECT_GT(footRemoved(off_floor, 2), 0.4);
 }
 
 }  // namespace
