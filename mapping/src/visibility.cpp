@@ -217,9 +217,10 @@ class ElementTable {
            e.masked >= options.mask_ratio * e.observed;
   }
 
-  /// Whether element i lies on a plane that the elements around it (within kSupportRadiusM)
-  /// confirm, those seen over more than mask_span_s and kept: the floor that a mask took with a
-  /// foot stays, the foot above it does not (nor the rest of a flat mover, seen as briefly).
+  /// Whether element i lies on a plane that the kept elements around it (within
+  /// kSupportRadiusM, seen by 2 keyframes or more, none of them a brief vote) span: the floor
+  /// that a mask took with a foot stays, the foot above it does not. (A flat mover's unmasked
+  /// rim can vouch for the rest of it.)
   bool onConfirmedPlane(std::uint64_t key, std::uint32_t i, const VisibilityOptions& options,
                         const std::vector<double>& stamps,
                         std::vector<Eigen::Vector3f>& support) const {
@@ -236,9 +237,9 @@ class ElementTable {
           const auto it = index_.find(shift(0, dx) | shift(1, dy) | shift(2, dz));
           if (it == index_.end() || it->second == i) continue;
           const Element& s = elements_[it->second];
-          const bool long_seen = s.observed >= 2 && s.last < stamps.size() &&
-                                 stamps[s.last] - stamps[s.first] > options.mask_span_s;
-          if (!long_seen || seenThrough(s, options) || plainVote(s, options)) continue;
+          if (s.observed < 2 || seenThrough(s, options) || plainVote(s, options) ||
+              briefUnderMask(s, options, stamps))
+            continue;
           support.push_back(centroids_[it->second]);
         }
       }

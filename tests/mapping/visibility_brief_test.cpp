@@ -97,9 +97,10 @@ TEST(VisibilityBrief, MoverStillForAMomentIsRemovedAndTheStaticSceneStays) {
   ASSERT_GT(cv::countNonZero(f0.mask), 300);  // the foot is in view
   const Pass p = run(withSpan(0.7), {});
   EXPECT_EQ(p.result.seen_through, 0u);  // nobody saw through it: only the votes can tell
-  // Its rim (blocks of keyframe 1's 1/4-resolution view less than half under the mask) stays.
-  EXPECT_GT(footRemoved(p, 0), 0.7);
-  EXPECT_GT(footRemoved(p, 2), 0.7);
+  // Its rim (blocks of keyframe 1's 1/4-resolution view less than half under the mask) stays,
+  // and a few voxels next to it on the box's flat faces, which the rim vouches for (67 % go).
+  EXPECT_GT(footRemoved(p, 0), 0.6);
+  EXPECT_GT(footRemoved(p, 2), 0.6);
   for (int k = 0; k < kKeyframes; ++k) {
     const int px = cv::countNonZero(p.frames[k].depth_m > 0);
     EXPECT_LT(staticRemoved(p, k), 0.005 * px) << k;
