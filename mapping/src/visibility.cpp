@@ -200,10 +200,17 @@ class ElementTable {
         brief.emplace_back(key, i);
       }
     }
-    std::vector<Eigen::Vector3f> support;
-    for (const auto& [key, i] : brief) {
-      if (onConfirmedPlane(key, i, options, stamps, support)) continue;
-      keys.insert(key);
+    // The plane test reads only: the candidates in two halves, one per thread.
+    std::vector<std::uint8_t> spared(brief.size(), 0);
+    inTwo([&](int h) {
+      std::vector<Eigen::Vector3f> support;
+      const std::size_t half = brief.size() / 2;
+      for (std::size_t b = h == 0 ? 0 : half; b < (h == 0 ? half : brief.size()); ++b)
+        spared[b] = onConfirmedPlane(brief[b].first, brief[b].second, options, stamps, support);
+    });
+    for (std::size_t b = 0; b < brief.size(); ++b) {
+      if (spared[b]) continue;
+      keys.insert(brief[b].first);
       ++*mask_voted;
     }
     return keys;
