@@ -64,7 +64,7 @@ run_tsan() {
     dynamap_tracking_tests dynamap_mapping_tests dynamap_cli_tests
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
-  nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|Visibility|AllBackends/VisibilityAllBackends|AllBackends/BackendContract|RunCommand|FaultInjection|Determinism)\\.}" \
+  nice -n 19 ctest --test-dir "$dir" -R "${TSAN_TESTS:-^(SyntheticTracking|TumTeddy|MappingWorker|Visibility|VisibilityBrief|AllBackends/VisibilityAllBackends|AllBackends/BackendContract|RunCommand|FaultInjection|Determinism)\\.}" \
       -E "${TSAN_EXCLUDE:-RealtimeModeKeepsTrackingLagBounded}" --output-on-failure -j"${TEST_JOBS:-2}" \
       ${CTEST_ARGS:-}
 }
