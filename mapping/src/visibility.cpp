@@ -25,14 +25,28 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+constexpr int kAxisBits = 21;
+constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
+
 /// 21 bits per axis (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
 std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
   const auto k = [inv_voxel](float v) {
     const double cell = std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15);
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << 20)) &
-           ((1u << 21) - 1);
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << (kAxisBits - 1))) &
+           kAxisMask;
   };
-  return k(p.x()) | (k(p.y()) << 21) | (k(p.z()) << 42);
+  return k(p.x()) | (k(p.y()) << kAxisBits) | (k(p.z()) << (2 * kAxisBits));
+}
+
+/// The key of the voxel (dx, dy, dz) cells away from `key`'s (wrapping as voxelKey() does).
+std::uint64_t offsetKey(std::uint64_t key, int dx, int dy, int dz) {
+  const int d[3] = {dx, dy, dz};
+  std::uint64_t out = 0;
+  for (int a = 0; a < 3; ++a) {
+    const std::uint64_t cell = (key >> (kAxisBits * a)) + static_cast<std::uint64_t>(d[a]);
+    out |= (cell & kAxisMask) << (kAxisBits * a);
+  }
+  return out;
 }
 
 struct Element {
@@ -96,6 +110,7 @@ bool briefUnderMask(const Element& e, const VisibilityOptions& options,
          e.in_view >= options.mask_span_view_ratio * e.observed;
 }
 
+enum class Verdict : std::uint8_t { kKept, kRemoved, kBrief };  ///< removedKeys()' first pass
 constexpr float kSupportRadiusM = 0.12f;  ///< onConfirmedPlane(): neighbourhood (cube half side)
 
 class ElementTable {
@@ -190,13 +205,20 @@ class ElementTable {
                                                 const std::vector<double>& stamps,
                                                 std::size_t* mask_voted) const {
     std::unordered_set<std::uint64_t> keys;
+    std::vector<Verdict> verdicts(elements_.size(), Verdict::kKept);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> brief;
     for (const auto& [key, i] : index_) {
       const Element& e = elements_[i];
-      if (seenThrough(e, options) || plainVote(e, options)) {
+      const bool seen_through =
+          e.seen_through >= static_cast<std::uint32_t>(std::max(1, options.min_views));
+      const bool voted = options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
+                         e.masked >= options.mask_ratio * e.observed;
+      if (seen_through || voted) {
+        verdicts[i] = Verdict::kRemoved;
         keys.insert(key);
-        if (!seenThrough(e, options)) ++*mask_voted;
+        if (!seen_through) ++*mask_voted;
       } else if (briefUnderMask(e, options, stamps)) {
+        verdicts[i] = Verdict::kBrief;
         brief.emplace_back(key, i);
       }
     }
@@ -206,7 +228,7 @@ class ElementTable {
       std::vector<Eigen::Vector3f> support;
       const std::size_t half = brief.size() / 2;
       for (std::size_t b = h == 0 ? 0 : half; b < (h == 0 ? half : brief.size()); ++b)
-        spared[b] = onConfirmedPlane(brief[b].first, brief[b].second, options, stamps, support);
+        spared[b] = onConfirmedPlane(brief[b].first, brief[b].second, verdicts, support);
     });
     for (std::size_t b = 0; b < brief.size(); ++b) {
       if (spared[b]) continue;
@@ -216,38 +238,23 @@ class ElementTable {
     return keys;
   }
   std::uint64_t key(const Eigen::Vector3f& p_W) const { return voxelKey(p_W, inv_voxel_); }
-  static bool seenThrough(const Element& e, const VisibilityOptions& options) {
-    return e.seen_through >= static_cast<std::uint32_t>(std::max(1, options.min_views));
-  }
-  static bool plainVote(const Element& e, const VisibilityOptions& options) {
-    return options.mask_min_views > 0 && e.masked >= options.mask_min_views &&
-           e.masked >= options.mask_ratio * e.observed;
-  }
 
   /// Whether element i lies on a plane that the kept elements around it (within
   /// kSupportRadiusM, seen by 2 keyframes or more, none of them a brief vote) span: the floor
   /// that a mask took with a foot stays, the foot above it does not. (A flat mover's unmasked
   /// rim can vouch for the rest of it.)
-  bool onConfirmedPlane(std::uint64_t key, std::uint32_t i, const VisibilityOptions& options,
-                        const std::vector<double>& stamps,
+  bool onConfirmedPlane(std::uint64_t key, std::uint32_t i, const std::vector<Verdict>& verdicts,
                         std::vector<Eigen::Vector3f>& support) const {
     const int reach = std::max(1, static_cast<int>(std::lround(kSupportRadiusM * inv_voxel_)));
-    constexpr std::uint64_t kMask = (1u << 21) - 1;
     support.clear();
     for (int dz = -reach; dz <= reach; ++dz) {
       for (int dy = -reach; dy <= reach; ++dy) {
         for (int dx = -reach; dx <= reach; ++dx) {
-          const auto shift = [&](int axis, int d) {
-            return ((((key >> (21 * axis)) & kMask) + static_cast<std::uint64_t>(d)) & kMask)
-                   << (21 * axis);
-          };
-          const auto it = index_.find(shift(0, dx) | shift(1, dy) | shift(2, dz));
+          const auto it = index_.find(offsetKey(key, dx, dy, dz));
           if (it == index_.end() || it->second == i) continue;
-          const Element& s = elements_[it->second];
-          if (s.observed < 2 || seenThrough(s, options) || plainVote(s, options) ||
-              briefUnderMask(s, options, stamps))
-            continue;
-          support.push_back(centroids_[it->second]);
+          const std::uint32_t j = it->second;
+          if (verdicts[j] == Verdict::kKept && elements_[j].observed >= 2)
+            support.push_back(centroids_[j]);
         }
       }
     }
