@@ -110,6 +110,58 @@ bool briefUnderMask(const Element& e, const VisibilityOptions& options,
          e.in_view >= options.mask_span_view_ratio * e.observed;
 }
 
+/// The beside-a-mover rule (options.mask_near_px): an element that a single keyframe saw,
+/// unmasked, that many more keyframes had in view, and that a keyframe within
+/// options.mask_span_s saw with a mover beside its projection, no farther than it
+/// (VisibilityView::mover_near_m).
+class BesideMover {
+ public:
+  BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
+              const VisibilityOptions& options, const std::vector<double>& stamps)
+      : camera_(camera), keyframes_(keyframes), options_(options), stamps_(stamps) {
+    if (options.mask_near_px <= 0 || options.mask_span_s <= 0.0) return;
+    T_C_W_.reserve(keyframes.size());
+    for (const auto& kf : keyframes) T_C_W_.push_back(kf.T_W_C.inverse().cast<float>());
+  }
+
+  bool holds(const Element& e, const Eigen::Vector3f& centroid) const {
+    if (T_C_W_.empty() || e.observed != 1 || e.masked != 0 || e.first >= stamps_.size() ||
+        e.in_view < options_.mask_span_view_ratio * e.observed) {
+      return false;
+    }
+    const double t = stamps_[e.first];
+    for (std::size_t j = e.first; j-- > 0 && t - stamps_[j] <= options_.mask_span_s;)
+      if (moverBeside(j, centroid)) return true;
+    for (std::size_t j = e.first; j < stamps_.size() && stamps_[j] - t <= options_.mask_span_s;
+         ++j) {
+      if (moverBeside(j, centroid)) return true;
+    }
+    return false;
+  }
+
+ private:
+  bool moverBeside(std::size_t j, const Eigen::Vector3f& centroid) const {
+    const VisibilityView* view = keyframes_[j].view;
+    if (view == nullptr || view->mover_near_m.empty()) return false;
+    const Eigen::Vector3f p = T_C_W_[j] * centroid;
+    if (p.z() < kMinDepthM) return false;
+    const double s = 1.0 / view->downsample;
+    const double u = (camera_.fx * p.x() / p.z() + camera_.cx) * s;
+    const double v = (camera_.fy * p.y() / p.z() + camera_.cy) * s;
+    const cv::Mat& near = view->mover_near_m;
+    if (!(u >= 0.0 && v >= 0.0 && u < near.cols && v < near.rows)) return false;
+    const float mover = near.at<float>(static_cast<int>(v), static_cast<int>(u));
+    const double margin = options_.margin_m + options_.margin_per_m2 * p.z() * p.z();
+    return mover > 0.0f && mover <= p.z() + margin;
+  }
+
+  const PinholeCamera& camera_;
+  const std::vector<VisibilityKeyframe>& keyframes_;
+  const VisibilityOptions& options_;
+  const std::vector<double>& stamps_;
+  std::vector<Eigen::Isometry3f> T_C_W_;
+};
+
 enum class Verdict : std::uint8_t { kKept, kRemoved, kBrief };  ///< removedKeys()' first pass
 constexpr float kSupportRadiusM = 0.12f;  ///< onConfirmedPlane(): neighbourhood (cube half side)
 
@@ -201,9 +253,12 @@ class ElementTable {
 
   /// Keys of the removed elements (a small set: fast lookups for every pixel); counts those
   /// removed by mask votes only. stamps: the keyframes' times (s), in view order.
-  std::unordered_set<std::uint64_t> removedKeys(const VisibilityOptions& options,
+  std::unordered_set<std::uint64_t> removedKeys(const PinholeCamera& camera,
+                                                const std::vector<VisibilityKeyframe>& keyframes,
+                                                const VisibilityOptions& options,
                                                 const std::vector<double>& stamps,
                                                 std::size_t* mask_voted) const {
+    const BesideMover beside(camera, keyframes, options, stamps);
     std::unordered_set<std::uint64_t> keys;
     std::vector<Verdict> verdicts(elements_.size(), Verdict::kKept);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> brief;
@@ -217,7 +272,7 @@ class ElementTable {
         verdicts[i] = Verdict::kRemoved;
         keys.insert(key);
         if (!seen_through) ++*mask_voted;
-      } else if (briefUnderMask(e, options, stamps)) {
+      } else if (briefUnderMask(e, options, stamps) || beside.holds(e, centroids_[i])) {
         verdicts[i] = Verdict::kBrief;
         brief.emplace_back(key, i);
       }
@@ -300,6 +355,15 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic
     cv::Mat share;  // block mean of the moving pixels
     cv::resize(cv::Mat(dynamic_mask == 255), share, block.size(), 0, 0, cv::INTER_AREA);
     view.moving = share >= 128;
+    const int reach = options.mask_near_px / view.downsample;
+    if (reach > 0 && cv::countNonZero(view.moving) > 0) {  // nearest mover within +-reach blocks
+      cv::Mat mover(block.size(), CV_32FC1, cv::Scalar(kNoReading));
+      block.copyTo(mover, view.moving & (block > 0.0f));
+      cv::erode(mover, mover,
+                cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
+      mover.setTo(0.0f, mover >= kNoReading);
+      view.mover_near_m = mover;
+    }
   }
   return view;
 }
@@ -347,7 +411,7 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
   std::vector<double> stamps(n);
   for (std::size_t i = 0; i < n; ++i) stamps[i] = keyframes[i].timestamp_s;
   const std::unordered_set<std::uint64_t> removed =
-      table.removedKeys(options, stamps, &result.mask_voted);
+      table.removedKeys(camera, keyframes, options, stamps, &result.mask_voted);
   result.seen_through = removed.size() - result.mask_voted;
   result.element_bytes = table.bytes();
   if (!removed.empty()) {

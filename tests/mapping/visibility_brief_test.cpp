@@ -22,21 +22,6 @@ const Box kFoot = SyntheticScene::movingBox(0);
 /// A mat on the floor, 3 mm thick, where a mask took the floor with a foot.
 const Box kMat{{-0.5, -0.4, 0.0}, {-0.2, -0.1, 0.003}};
 
-/// `hidden` shrunk halfway towards camera k (bounding box of its corners): it hides `hidden`
-/// and little else.
-Box occluderFor(int k, const Box& hidden) {
-  const Eigen::Vector3d eye = SyntheticScene::pose(k, kKeyframes).translation();
-  Box b{Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(-1e9)};
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d corner((c & 1) ? hidden.hi.x() : hidden.lo.x(),
-                                 (c & 2) ? hidden.hi.y() : hidden.lo.y(),
-                                 (c & 4) ? hidden.hi.z() : hidden.lo.z());
-    const Eigen::Vector3d p = eye + 0.5 * (corner - eye);
-    b.lo = b.lo.cwiseMin(p), b.hi = b.hi.cwiseMax(p);
-  }
-  return b;
-}
-
 struct Pass {
   std::vector<SyntheticFrame> frames;
   std::vector<cv::Mat> depths;  // static depth: masked pixels 0, edited by the pass
@@ -54,8 +39,9 @@ Pass run(const VisibilityOptions& options, const std::vector<int>& seen_again,
   std::vector<cv::Mat> masks;
   for (int k = 0; k < kKeyframes; ++k) {
     const bool foot = k < 3 || std::count(seen_again.begin(), seen_again.end(), k) > 0;
-    p.frames.push_back(
-        scene.render(k, kKeyframes, foot ? foot_box : occluderFor(k, hidden ? *hidden : foot_box)));
+    p.frames.push_back(scene.render(
+        k, kKeyframes,
+        foot ? foot_box : SyntheticScene::occluderFor(k, kKeyframes, hidden ? *hidden : foot_box)));
     const SyntheticFrame& f = p.frames.back();
     masks.push_back(foot && k != 1 ? cv::Mat::zeros(f.mask.size(), CV_8UC1) : f.mask);
     p.depths.push_back(f.depth_m.clone());

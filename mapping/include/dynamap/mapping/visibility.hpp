@@ -27,6 +27,13 @@ struct VisibilityOptions {
   /// times as many keyframes had in view, is a mover that stood still for a moment.
   double mask_span_s = 0.7;
   double mask_span_view_ratio = 2.0;
+  /// Beside a mover (0 = off): an element that a single keyframe saw, unmasked, and that at
+  /// least mask_span_view_ratio times as many keyframes had in view, is a mover's part that every
+  /// mask missed when a keyframe within mask_span_s had moving pixels within this many pixels of
+  /// its projection, no farther than it (a leg showing beside a box before anything detected
+  /// the person). Voxels of this rule and the brief one stay when they lie on the plane of the
+  /// kept voxels around them.
+  int mask_near_px = 24;
 };
 
 /// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
@@ -36,6 +43,8 @@ struct VisibilityOptions {
 struct VisibilityView {
   cv::Mat near_m;  ///< CV_32FC1, 0 = no reading in the window
   cv::Mat moving;  ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
+  /// CV_32FC1: the nearest moving surface within options.mask_near_px (0 = none); may be empty
+  cv::Mat mover_near_m;
   int downsample = 1;
 };
 
@@ -68,9 +77,10 @@ struct VisibilityResult {
 /// through (the view's surface at its projection lies behind it by more than margin_m +
 /// margin_per_m2 * z^2) was not there at that time: its pixels are set to 0 in every
 /// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
-/// dynamic mask (options.mask_min_views, mask_ratio), and one that a keyframe saw under its mask
+/// dynamic mask (options.mask_min_views, mask_ratio), one that a keyframe saw under its mask
 /// and all keyframes saw only within a short time (options.mask_span_s, mask_span_view_ratio;
-/// keyframes must come in time order). Anything that every visit saw (a
+/// keyframes must come in time order), and one that a single keyframe saw beside a mover
+/// (options.mask_near_px). Anything that every visit saw (a
 /// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
 /// point pairs. Runs on two threads (keyframes keyed two at a time and added in their order,
 /// elements split in halves, removal split by keyframe): the result does not depend on the
