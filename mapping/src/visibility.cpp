@@ -13,12 +13,17 @@
 #include "dynamap/mapping/radix_sort.hpp"
 #include "in_two.hpp"
 #include "plane_fit.hpp"
+#include "visibility_votes.hpp"
 
 namespace dynamap {
 namespace {
 
+using vis::BesideMover;
+using vis::briefUnderMask;
+using vis::Element;
+using vis::kMinDepthM;
+
 constexpr float kNoReading = 1e9f;
-constexpr double kMinDepthM = 0.1;  // elements nearer to a camera than this are not checked
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
@@ -48,17 +53,6 @@ std::uint64_t offsetKey(std::uint64_t key, int dx, int dy, int dz) {
   }
   return out;
 }
-
-struct Element {
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  std::uint32_t count = 0;
-  std::uint32_t seen_through = 0;
-  std::uint16_t observed = 0;  ///< keyframes whose surface at the projection is this element
-  std::uint16_t masked = 0;    ///< of those, under the keyframe's dynamic mask
-  std::uint16_t in_view = 0;   ///< keyframes with a depth reading at its projection
-  std::uint32_t first = std::numeric_limits<std::uint32_t>::max();  ///< first observing keyframe
-  std::uint32_t last = 0;                                           ///< last observing keyframe
-};
 
 /// A keyframe's static points in runs of consecutive points of one voxel (neighbouring pixels of
 /// a row mostly share a 2 cm voxel), the runs sorted by voxel key, then by their first point.
@@ -99,68 +93,6 @@ void forEachStaticPoint(const PinholeCamera& camera, const VisibilityKeyframe& k
     forEachStaticPointT<float>(camera, kf, fn);
   }
 }
-
-/// A mover that stood still for a moment (a foot during a step): some keyframe saw the element
-/// under its mask, every keyframe that saw it did so within options.mask_span_s, and many more
-/// had it in view (something else in front, or the surface behind it within the margin).
-bool briefUnderMask(const Element& e, const VisibilityOptions& options,
-                    const std::vector<double>& stamps) {
-  if (options.mask_span_s <= 0.0 || e.masked == 0 || e.last >= stamps.size()) return false;
-  return stamps[e.last] - stamps[e.first] <= options.mask_span_s &&
-         e.in_view >= options.mask_span_view_ratio * e.observed;
-}
-
-/// The beside-a-mover rule (options.mask_near_px): an element that a single keyframe saw,
-/// unmasked, that many more keyframes had in view, and that a keyframe within
-/// options.mask_span_s saw with a mover beside its projection, no farther than it
-/// (VisibilityView::mover_near_m).
-class BesideMover {
- public:
-  BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
-              const VisibilityOptions& options, const std::vector<double>& stamps)
-      : camera_(camera), keyframes_(keyframes), options_(options), stamps_(stamps) {
-    if (options.mask_near_px <= 0 || options.mask_span_s <= 0.0) return;
-    T_C_W_.reserve(keyframes.size());
-    for (const auto& kf : keyframes) T_C_W_.push_back(kf.T_W_C.inverse().cast<float>());
-  }
-
-  bool holds(const Element& e, const Eigen::Vector3f& centroid) const {
-    if (T_C_W_.empty() || e.observed != 1 || e.masked != 0 || e.first >= stamps_.size() ||
-        e.in_view < options_.mask_span_view_ratio * e.observed) {
-      return false;
-    }
-    const double t = stamps_[e.first];
-    for (std::size_t j = e.first; j-- > 0 && t - stamps_[j] <= options_.mask_span_s;)
-      if (moverBeside(j, centroid)) return true;
-    for (std::size_t j = e.first; j < stamps_.size() && stamps_[j] - t <= options_.mask_span_s;
-         ++j) {
-      if (moverBeside(j, centroid)) return true;
-    }
-    return false;
-  }
-
- private:
-  bool moverBeside(std::size_t j, const Eigen::Vector3f& centroid) const {
-    const VisibilityView* view = keyframes_[j].view;
-    if (view == nullptr || view->mover_near_m.empty()) return false;
-    const Eigen::Vector3f p = T_C_W_[j] * centroid;
-    if (p.z() < kMinDepthM) return false;
-    const double s = 1.0 / view->downsample;
-    const double u = (camera_.fx * p.x() / p.z() + camera_.cx) * s;
-    const double v = (camera_.fy * p.y() / p.z() + camera_.cy) * s;
-    const cv::Mat& near = view->mover_near_m;
-    if (!(u >= 0.0 && v >= 0.0 && u < near.cols && v < near.rows)) return false;
-    const float mover = near.at<float>(static_cast<int>(v), static_cast<int>(u));
-    const double margin = options_.margin_m + options_.margin_per_m2 * p.z() * p.z();
-    return mover > 0.0f && mover <= p.z() + margin;
-  }
-
-  const PinholeCamera& camera_;
-  const std::vector<VisibilityKeyframe>& keyframes_;
-  const VisibilityOptions& options_;
-  const std::vector<double>& stamps_;
-  std::vector<Eigen::Isometry3f> T_C_W_;
-};
 
 enum class Verdict : std::uint8_t { kKept, kRemoved, kBrief };  ///< removedKeys()' first pass
 constexpr float kSupportRadiusM = 0.12f;  ///< onConfirmedPlane(): neighbourhood (cube half side)
