@@ -287,15 +287,6 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic
     cv::Mat share;  // block mean of the moving pixels
     cv::resize(cv::Mat(dynamic_mask == 255), share, block.size(), 0, 0, cv::INTER_AREA);
     view.moving = share >= 128;
-    const int reach = options.mask_near_px / view.downsample;
-    if (reach > 0 && cv::countNonZero(view.moving) > 0) {  // nearest mover within +-reach blocks
-      cv::Mat mover(block.size(), CV_32FC1, cv::Scalar(kNoReading));
-      block.copyTo(mover, view.moving & (block > 0.0f));
-      cv::erode(mover, mover,
-                cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
-      mover.setTo(0.0f, mover >= kNoReading);
-      view.mover_near_m = mover;
-    }
   }
   return view;
 }

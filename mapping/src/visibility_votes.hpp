@@ -1,6 +1,7 @@
 #pragma once
 // The visibility pass's map elements and its vote rules for movers that no keyframe saw through
 // (briefUnderMask(), BesideMover). Internal to dynamap_mapping (mapping/src/visibility.cpp).
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -38,10 +39,9 @@ inline bool briefUnderMask(const Element& e, const VisibilityOptions& options,
          e.in_view >= options.mask_span_view_ratio * e.observed;
 }
 
-/// The beside-a-mover rule (options.mask_near_px): an element that a single keyframe saw,
-/// unmasked, that many more keyframes had in view, and that a keyframe within
-/// options.mask_span_s saw with a mover beside its projection, no farther than it
-/// (VisibilityView::mover_near_m).
+/// The beside-a-mover rule (options.mask_near_px, mask_near_depth_m): an element that a single
+/// keyframe saw, unmasked, that many more keyframes had in view, and that a keyframe within
+/// options.mask_span_s saw with moving blocks near its projection and near its depth.
 class BesideMover {
  public:
   BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
@@ -70,17 +70,27 @@ class BesideMover {
  private:
   bool moverBeside(std::size_t j, const Eigen::Vector3f& centroid) const {
     const VisibilityView* view = keyframes_[j].view;
-    if (view == nullptr || view->mover_near_m.empty()) return false;
+    if (view == nullptr || view->moving.size() != view->near_m.size()) return false;
     const Eigen::Vector3f p = T_C_W_[j] * centroid;
     if (p.z() < kMinDepthM) return false;
     const double s = 1.0 / view->downsample;
     const double u = (camera_.fx * p.x() / p.z() + camera_.cx) * s;
     const double v = (camera_.fy * p.y() / p.z() + camera_.cy) * s;
-    const cv::Mat& near = view->mover_near_m;
+    const cv::Mat& near = view->near_m;
     if (!(u >= 0.0 && v >= 0.0 && u < near.cols && v < near.rows)) return false;
-    const float mover = near.at<float>(static_cast<int>(v), static_cast<int>(u));
-    const double margin = options_.margin_m + options_.margin_per_m2 * p.z() * p.z();
-    return mover > 0.0f && mover <= p.z() + margin;
+    const auto hi =
+        static_cast<float>(p.z() + options_.margin_m + options_.margin_per_m2 * p.z() * p.z());
+    const auto lo = static_cast<float>(p.z() - options_.mask_near_depth_m);
+    const int reach = options_.mask_near_px / view->downsample;
+    const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+    for (int y = std::max(0, v0 - reach); y <= std::min(near.rows - 1, v0 + reach); ++y) {
+      const float* depth = near.ptr<float>(y);
+      const std::uint8_t* moving = view->moving.ptr<std::uint8_t>(y);
+      for (int x = std::max(0, u0 - reach); x <= std::min(near.cols - 1, u0 + reach); ++x) {
+        if (moving[x] != 0 && depth[x] > 0.0f && depth[x] >= lo && depth[x] <= hi) return true;
+      }
+    }
+    return false;
   }
 
   const PinholeCamera& camera_;

@@ -30,6 +30,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.visibility_mask_span_s", &vis.mask_span_s, 0.0, 1e6);
   schema.addDouble("mapping.visibility_mask_span_view_ratio", &vis.mask_span_view_ratio, 0.0, 1e6);
   schema.addInt("mapping.visibility_mask_near_px", &vis.mask_near_px, 0, 1000);
+  schema.addDouble("mapping.visibility_mask_near_depth_m", &vis.mask_near_depth_m, 0.0, 100.0);
   schema.addBool("mapping.deferred_integration", &s.deferred_integration);
 }
 

@@ -55,8 +55,8 @@ KeyframePacketPtr packet(std::uint64_t id) {
 }
 
 /// For the tests that count integrations, which assume the visibility pass removes nothing:
-/// beside the moving box its beside-a-mover votes take a few floor pixels that one of these few
-/// keyframes saw at a grazing angle (and the worker would rebuild).
+/// beside the moving box its beside-a-mover votes take a few room voxels that only one of these
+/// few keyframes saw (and the worker would rebuild).
 StaticPointsOptions countingOptions() {
   StaticPointsOptions o;
   o.visibility.mask_near_px = 0;

@@ -94,16 +94,16 @@ class SyntheticScene {
     return T;
   }
 
-  /// `hidden` shrunk halfway towards camera k of n (bounding box of its corners): a box that
-  /// hides `hidden` from that camera and little else.
-  static Box occluderFor(int k, int n, const Box& hidden) {
+  /// `hidden` moved `share` of the way towards camera k of n and shrunk with it (bounding box of
+  /// its corners): a box that hides `hidden` from that camera and little else.
+  static Box occluderFor(int k, int n, const Box& hidden, double share = 0.5) {
     const Eigen::Vector3d eye = pose(k, n).translation();
     Box b{Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(-1e9)};
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d corner((c & 1) ? hidden.hi.x() : hidden.lo.x(),
                                    (c & 2) ? hidden.hi.y() : hidden.lo.y(),
                                    (c & 4) ? hidden.hi.z() : hidden.lo.z());
-      const Eigen::Vector3d p = eye + 0.5 * (corner - eye);
+      const Eigen::Vector3d p = eye + (1.0 - share) * (corner - eye);
       b.lo = b.lo.cwiseMin(p), b.hi = b.hi.cwiseMax(p);
     }
     return b;

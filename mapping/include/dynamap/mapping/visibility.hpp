@@ -29,11 +29,13 @@ struct VisibilityOptions {
   double mask_span_view_ratio = 2.0;
   /// Beside a mover (0 = off): an element that a single keyframe saw, unmasked, and that at
   /// least mask_span_view_ratio times as many keyframes had in view, is a mover's part that every
-  /// mask missed when a keyframe within mask_span_s had moving pixels within this many pixels of
-  /// its projection, no farther than it (a leg showing beside a box before anything detected
-  /// the person). Voxels of this rule and the brief one stay when they lie on the plane of the
-  /// kept voxels around them.
+  /// mask missed when a keyframe within mask_span_s had moving pixels within mask_near_px pixels
+  /// of its projection at a depth from mask_near_depth_m in front of it to the margin behind it
+  /// (a leg showing beside a box before anything detected the person; not a passer-by far in
+  /// front). Voxels of this rule and the brief one stay when they lie on the plane of the kept
+  /// voxels around them.
   int mask_near_px = 24;
+  double mask_near_depth_m = 0.3;
 };
 
 /// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
@@ -43,8 +45,6 @@ struct VisibilityOptions {
 struct VisibilityView {
   cv::Mat near_m;  ///< CV_32FC1, 0 = no reading in the window
   cv::Mat moving;  ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
-  /// CV_32FC1: the nearest moving surface within options.mask_near_px (0 = none); may be empty
-  cv::Mat mover_near_m;
   int downsample = 1;
 };
 
