@@ -1,6 +1,7 @@
 #pragma once
 // The visibility pass's map elements and its vote rules for movers that no keyframe saw through
-// (briefUnderMask(), BesideMover). Internal to dynamap_mapping (mapping/src/visibility.cpp).
+// (seenBriefly(), briefUnderMask(), BesideMover). Internal to dynamap_mapping
+// (mapping/src/visibility.cpp).
 #include <algorithm>
 #include <cstdint>
 #include <limits>
@@ -29,19 +30,26 @@ struct Element {
   std::uint32_t last = 0;                                           ///< last observing keyframe
 };
 
-/// A mover that stood still for a moment (a foot during a step): some keyframe saw the element
-/// under its mask, every keyframe that saw it did so within options.mask_span_s, and many more
-/// had it in view (something else in front, or the surface behind it within the margin).
-inline bool briefUnderMask(const Element& e, const VisibilityOptions& options,
-                           const std::vector<double>& stamps) {
-  if (options.mask_span_s <= 0.0 || e.masked == 0 || e.last >= stamps.size()) return false;
+/// What both vote rules below ask of an element: some keyframe saw it, every keyframe that saw
+/// it did so within options.mask_span_s, and at least mask_span_view_ratio times as many had it
+/// in view (something else in front, or the surface behind it within the margin).
+inline bool seenBriefly(const Element& e, const VisibilityOptions& options,
+                        const std::vector<double>& stamps) {
+  if (options.mask_span_s <= 0.0 || e.observed == 0 || e.last >= stamps.size()) return false;
   return stamps[e.last] - stamps[e.first] <= options.mask_span_s &&
          e.in_view >= options.mask_span_view_ratio * e.observed;
 }
 
+/// A mover that stood still for a moment (a foot during a step): seen briefly, and by some
+/// keyframe under its mask.
+inline bool briefUnderMask(const Element& e, const VisibilityOptions& options,
+                           const std::vector<double>& stamps) {
+  return e.masked != 0 && seenBriefly(e, options, stamps);
+}
+
 /// The beside-a-mover rule (options.mask_near_px, mask_near_depth_m): an element that a single
-/// keyframe saw, unmasked, that many more keyframes had in view, and that a keyframe within
-/// options.mask_span_s saw with moving blocks near its projection and near its depth.
+/// keyframe saw, unmasked, seen briefly, and that a keyframe within options.mask_span_s saw with
+/// moving blocks near its projection and near its depth.
 class BesideMover {
  public:
   BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
@@ -53,15 +61,12 @@ class BesideMover {
   }
 
   bool holds(const Element& e, const Eigen::Vector3f& centroid) const {
-    if (T_C_W_.empty() || e.observed != 1 || e.masked != 0 || e.first >= stamps_.size() ||
-        e.in_view < options_.mask_span_view_ratio * e.observed) {
+    if (T_C_W_.empty() || e.observed != 1 || e.masked != 0 || !seenBriefly(e, options_, stamps_))
       return false;
-    }
     const double t = stamps_[e.first];
-    for (std::size_t j = e.first; j-- > 0 && t - stamps_[j] <= options_.mask_span_s;)
-      if (moverBeside(j, centroid)) return true;
-    for (std::size_t j = e.first; j < stamps_.size() && stamps_[j] - t <= options_.mask_span_s;
-         ++j) {
+    std::size_t j = e.first;  // the keyframes within mask_span_s of the one that saw it
+    while (j > 0 && t - stamps_[j - 1] <= options_.mask_span_s) --j;
+    for (; j < stamps_.size() && stamps_[j] - t <= options_.mask_span_s; ++j) {
       if (moverBeside(j, centroid)) return true;
     }
     return false;
