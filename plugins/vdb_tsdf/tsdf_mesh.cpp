@@ -31,7 +31,7 @@ PlyData TsdfVolume::extractMesh() const {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(*tsdf_, points, triangles, quads, 0.0, 0.0);
+  openvdb::tools::volumeToMesh(*votedTsdf(), points, triangles, quads, 0.0, 0.0);
 
   const float inv_voxel = static_cast<float>(1.0 / options_.voxel_size_m);
   auto weights = weight_->getConstAccessor();

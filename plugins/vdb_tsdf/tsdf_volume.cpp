@@ -58,6 +58,21 @@ void TsdfVolume::reset() {
   color_ = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
   color_->setTransform(transform->copy());
   color_->setName("color");
+  free_ = openvdb::FloatGrid::create(0.0f);
+  free_->setTransform(transform->copy());
+  free_->setName("free_views");
+}
+
+openvdb::FloatGrid::ConstPtr TsdfVolume::votedTsdf() const {
+  if (!options_.free_votes) return tsdf_;
+  openvdb::FloatGrid::Ptr voted = tsdf_->deepCopy();
+  auto acc = voted->getAccessor();
+  auto weights = weight_->getConstAccessor();
+  for (auto it = free_->cbeginValueOn(); it; ++it) {
+    const float w = weights.getValue(it.getCoord());
+    if (w > 0.0f && *it > options_.free_vote_ratio * w) acc.setValue(it.getCoord(), 1.0f);
+  }
+  return voted;
 }
 
 std::vector<openvdb::Coord> TsdfVolume::collectBlocks(const PinholeCamera& camera,
@@ -122,13 +137,17 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
   std::vector<FloatLeaf*> tsdf_leaves(blocks.size());
   std::vector<FloatLeaf*> weight_leaves(blocks.size());
   std::vector<ColorLeaf*> color_leaves(blocks.size());
+  std::vector<FloatLeaf*> free_leaves(options_.free_votes ? blocks.size() : 0);
   // Each grid's tree is touched by one thread (trees are not safe for concurrent writes).
   auto touch = [&blocks](auto& grid, auto& leaves) {
     auto acc = grid.getAccessor();
     for (std::size_t i = 0; i < blocks.size(); ++i) leaves[i] = acc.touchLeaf(blocks[i]);
   };
   tbb::parallel_invoke([&] { touch(*tsdf_, tsdf_leaves); }, [&] { touch(*weight_, weight_leaves); },
-                       [&] { touch(*color_, color_leaves); });
+                       [&] { touch(*color_, color_leaves); },
+                       [&] {
+                         if (options_.free_votes) touch(*free_, free_leaves);
+                       });
   const Eigen::Isometry3d T_C_W = T_W_C.inverse();
   const Eigen::Matrix3f R = T_C_W.rotation().cast<float>();
   const Eigen::Vector3f t = T_C_W.translation().cast<float>();
@@ -143,6 +162,7 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
       FloatLeaf& tl = *tsdf_leaves[b];
       FloatLeaf& wl = *weight_leaves[b];
       ColorLeaf& cl = *color_leaves[b];
+      FloatLeaf* fl = options_.free_votes ? free_leaves[b] : nullptr;
       const openvdb::Coord o = blocks[b];
       for (int x = 0; x < kLeafDim; ++x) {
         for (int y = 0; y < kLeafDim; ++y) {
@@ -158,6 +178,10 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
             const float sdf = d - p_C.z();
             if (sdf < -trunc) continue;
             const openvdb::Index n = (x << 6) | (y << 3) | z;
+            if (fl != nullptr && sdf > trunc) {
+              fl->setValueOn(n, fl->getValue(n) + 1.0f);
+              continue;
+            }
             const float w_old = wl.getValue(n);
             const float obs = std::min(1.0f, sdf / trunc);
             float w = 1.0f;
@@ -178,11 +202,12 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
 }
 
 std::size_t TsdfVolume::memoryBytes() const {
-  return tsdf_->memUsage() + weight_->memUsage() + color_->memUsage();
+  return tsdf_->memUsage() + weight_->memUsage() + color_->memUsage() + free_->memUsage();
 }
 
 void TsdfVolume::writeVdb(const std::string& path) const {
-  openvdb::GridPtrVec grids{tsdf_, weight_, color_};
+  openvdb::GridCPtrVec grids{votedTsdf(), weight_, color_};
+  if (options_.free_votes) grids.push_back(free_);
   openvdb::io::File file(path);
   file.write(grids);
   file.close();

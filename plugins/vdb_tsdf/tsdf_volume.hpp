@@ -18,11 +18,17 @@ struct TsdfOptions {
   double voxel_size_m = 0.02;
   double truncation_m = 0.08;
   float max_weight = 100.0f;
-  float min_weight = 1.0f;       ///< export: every corner of a mesh cell needs this weight
-  bool space_carving = true;     ///< visit existing blocks in front of the surface
+  float min_weight = 1.0f;        ///< export: every corner of a mesh cell needs this weight
+  bool space_carving = true;      ///< visit existing blocks in front of the surface
   bool linear_weighting = false;  ///< weight falls off linearly behind the surface
-  int alloc_stride_px = 4;       ///< pixel step when finding the blocks around the surface
-  int carve_stride_px = 12;      ///< pixel step of the rays looking for stale blocks
+  int alloc_stride_px = 4;        ///< pixel step when finding the blocks around the surface
+  int carve_stride_px = 12;       ///< pixel step of the rays looking for stale blocks
+  /// Views that see a voxel more than the truncation in front of their surface (free space)
+  /// vote instead of averaging +1 into it: the voxel is free when more views saw through it than
+  /// free_vote_ratio x the views that saw it within the truncation band. Averaged, one view whose
+  /// pose is a degree off past an edge erases a floor that ten views saw.
+  bool free_votes = true;
+  float free_vote_ratio = 1.0f;
 };
 
 /// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight, colour), integrated
@@ -49,6 +55,9 @@ class TsdfVolume {
   openvdb::FloatGrid::Ptr tsdf_;
   openvdb::FloatGrid::Ptr weight_;
   openvdb::Vec3SGrid::Ptr color_;
+  openvdb::FloatGrid::Ptr free_;  ///< views that saw through each voxel (free_votes)
+  /// tsdf_ with the voxels the free votes carve set to +1 (tsdf_ itself without free_votes).
+  openvdb::FloatGrid::ConstPtr votedTsdf() const;
 };
 
 }  // namespace dynamap::plugin
