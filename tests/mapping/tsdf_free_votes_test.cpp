@@ -67,11 +67,11 @@ cv::Mat noisyDepth(const PinholeCamera& cam, const Eigen::Isometry3d& T_W_C, std
 /// seeded; `stale` in the first `stale_views` views only), exports, returns the mesh vertices.
 std::vector<Eigen::Vector3f> floorMesh(const BackendParams& params, int n, double jitter_deg,
                                        const std::string& name, const Box* stale = nullptr,
-                                       int stale_views = 1) {
+                                       int stale_views = 1, unsigned seed = 7) {
   const auto registry = BackendRegistry::scan({pluginDir()});
   auto backend = registry.create("vdb_tsdf", params);
   const PinholeCamera cam = halfVga();
-  std::mt19937 rng(7);
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> axis(-1.0, 1.0);
   const cv::Mat bgr(cam.height, cam.width, CV_8UC3, cv::Scalar(90, 120, 150));
   for (int k = 0; k < n; ++k) {
@@ -79,7 +79,8 @@ std::vector<Eigen::Vector3f> floorMesh(const BackendParams& params, int n, doubl
     const Box table{{-0.3, -0.3, 0.0}, {0.3, 0.3, 0.6}};
     const cv::Mat depth =
         noisyDepth(cam, T, rng, k < stale_views && stale != nullptr ? stale : &table);
-    const Eigen::Vector3d a(axis(rng), axis(rng), axis(rng));
+    Eigen::Vector3d a;
+    for (int i = 0; i < 3; ++i) a[i] = axis(rng);  // in this order (arguments have none)
     Eigen::Isometry3d T_given = T;
     T_given.linear() =
         T.linear() * Eigen::AngleAxisd(jitter_deg * M_PI / 180.0, a.normalized()).matrix();
@@ -122,15 +123,20 @@ bool vdbBuilt() { return !BackendRegistry::scan({pluginDir()}).pluginPath("vdb_t
 const BackendParams kDefaults = {{"voxel_size_m", "0.02"}};
 const BackendParams kAveraged = {{"voxel_size_m", "0.02"}, {"free_votes", "false"}};
 
-// The floor behind the table: views whose poses are 1.5 deg off see it past the table's edge
-// where their ray ends farther away. Averaged into the distances that free space eats the floor
-// (measured 0.44 of it left; 0.87 voted); 1 deg: 0.97 / 0.99.
+// The floor behind the table: views whose poses are 1.5 deg off (random axes, 6 seeded draws) see
+// it past the table's edge where their ray ends farther away. Averaged into the distances that
+// free space eats the floor (measured: 0.824 of it left over the draws, worst 0.635); voted 0.922
+// (worst 0.790). Exact poses: 0.99.
 TEST(TsdfFreeVotes, FloorBehindAnEdgeSurvivesPoseErrors) {
   if (!vdbBuilt()) GTEST_SKIP() << "vdb_tsdf backend not built";
   EXPECT_GE(floorCoverage(floorMesh(kDefaults, 10, 0.0, "exact")), 0.97);
-  EXPECT_GE(floorCoverage(floorMesh(kDefaults, 10, 1.5, "voted")), 0.80);
-  EXPECT_LE(floorCoverage(floorMesh(kAveraged, 10, 1.5, "averaged")), 0.60)
-      << "the scene no longer shows what the votes are for";
+  double voted = 0.0, averaged = 0.0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    voted += floorCoverage(floorMesh(kDefaults, 10, 1.5, "voted", nullptr, 1, seed)) / 6;
+    averaged += floorCoverage(floorMesh(kAveraged, 10, 1.5, "averaged", nullptr, 1, seed)) / 6;
+  }
+  EXPECT_GE(voted, 0.88);
+  EXPECT_LE(averaged, voted - 0.05) << "the scene no longer shows what the votes are for";
 }
 
 // Mesh vertices inside (2 cm around) `box` higher than z above the floor.
