@@ -230,7 +230,10 @@ void System::finish() {
   s.finished = true;
   s.releasePending(s.last_mapped);
   if (s.tracker) {
-    s.tracker->finish();
+    {
+      ScopedStageTimer timer(s.timings, "finish_tracking");  // last bundle adjustment
+      s.tracker->finish();
+    }
     std::vector<PoseUpdate> final_poses;
     for (const auto& kf : s.tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
     s.mapper->applyPoseUpdates(final_poses);
@@ -246,6 +249,7 @@ std::vector<KeyframePacketPtr> System::takeLastMapped() {
 void System::exportMap(const std::string& dir) {
   finish();
   std::filesystem::create_directories(dir);
+  ScopedStageTimer timer(impl_->timings, "map_export");
   impl_->mapper->exportMap(dir);
 }
 
