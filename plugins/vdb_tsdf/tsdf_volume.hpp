@@ -31,7 +31,8 @@ struct TsdfOptions {
   float free_vote_ratio = 1.0f;
 };
 
-/// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight, colour), integrated
+/// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight = views within the
+/// truncation band, colour, and with free_votes the views that saw through), integrated
 /// projectively: the 8^3 leaf blocks within the truncation band of the observed depth (and, with
 /// space carving, existing blocks along the rays in front of it) are found from the depth image,
 /// then every voxel of those blocks is projected into the depth image (TBB over blocks).
