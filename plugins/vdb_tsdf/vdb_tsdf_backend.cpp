@@ -31,7 +31,7 @@ plugin::TsdfOptions readOptions(const BackendParams& params) {
   o.alloc_stride_px = reader.getInt("alloc_stride_px", 4, 1, 64);
   o.carve_stride_px = reader.getInt("carve_stride_px", 12, 1, 256);
   o.free_votes = reader.getBool("free_votes", true);
-  o.free_vote_ratio = static_cast<float>(reader.getDouble("free_vote_ratio", 1.0, 0.01, 100.0));
+  o.free_vote_ratio = static_cast<float>(reader.getDouble("free_vote_ratio", 0.5, 0.01, 100.0));
   reader.finish();
   return o;
 }

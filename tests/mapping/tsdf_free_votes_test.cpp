@@ -125,8 +125,8 @@ const BackendParams kAveraged = {{"voxel_size_m", "0.02"}, {"free_votes", "false
 
 // The floor behind the table: views whose poses are 1.5 deg off (random axes, 6 seeded draws) see
 // it past the table's edge where their ray ends farther away. Averaged into the distances that
-// free space eats the floor (measured: 0.824 of it left over the draws, worst 0.635); voted 0.922
-// (worst 0.790). Exact poses: 0.99.
+// free space eats the floor (measured: 0.824 of it left over the draws, worst 0.635); voted 0.886
+// (worst 0.688; 0.922 / 0.790 at free_vote_ratio 1). Exact poses: 0.99.
 TEST(TsdfFreeVotes, FloorBehindAnEdgeSurvivesPoseErrors) {
   if (!vdbBuilt()) GTEST_SKIP() << "vdb_tsdf backend not built";
   EXPECT_GE(floorCoverage(floorMesh(kDefaults, 10, 0.0, "exact")), 0.97);
@@ -135,8 +135,8 @@ TEST(TsdfFreeVotes, FloorBehindAnEdgeSurvivesPoseErrors) {
     voted += floorCoverage(floorMesh(kDefaults, 10, 1.5, "voted", nullptr, 1, seed)) / 6;
     averaged += floorCoverage(floorMesh(kAveraged, 10, 1.5, "averaged", nullptr, 1, seed)) / 6;
   }
-  EXPECT_GE(voted, 0.88);
-  EXPECT_LE(averaged, voted - 0.05) << "the scene no longer shows what the votes are for";
+  EXPECT_GE(voted, 0.85);
+  EXPECT_LE(averaged, voted - 0.03) << "the scene no longer shows what the votes are for";
 }
 
 // Mesh vertices inside (2 cm around) `box` higher than z above the floor.
@@ -147,9 +147,9 @@ std::size_t above(const std::vector<Eigen::Vector3f>& mesh, const Box& box, floa
 }
 
 // A bag 1-2 m in front of the floor the views see behind it, there in the first views only (taken
-// away, unmasked): carved down to the floor when one view saw it, kept when most saw it. The price
-// of voting (measured): there in the first 3 of 10 views, 736 vertices stay voted, 128 averaged
-// (only some later views see through it); the visibility pass is what removes such things.
+// away, unmasked): carved down to the floor when one or two views saw it, kept when most saw it
+// (measured: there in the first 3 of 10 views, 20 vertices stay voted, 128 averaged; 736 at
+// free_vote_ratio 1, as only some later views see through it).
 TEST(TsdfFreeVotes, ThingMostViewsSawThroughIsCarved) {
   if (!vdbBuilt()) GTEST_SKIP() << "vdb_tsdf backend not built";
   const Box bag{{-1.35, -0.95, 0.0}, {-1.05, -0.65, 0.6}};
