@@ -27,11 +27,11 @@ bool cellObserved(Accessor& weights, const openvdb::Vec3s& q, float min_weight) 
 
 }  // namespace
 
-PlyData TsdfVolume::extractMesh() const {
+PlyData TsdfVolume::extractMesh(const openvdb::FloatGrid& voted) const {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(*votedTsdf(), points, triangles, quads, 0.0, 0.0);
+  openvdb::tools::volumeToMesh(voted, points, triangles, quads, 0.0, 0.0);
 
   const float inv_voxel = static_cast<float>(1.0 / options_.voxel_size_m);
   auto weights = weight_->getConstAccessor();

@@ -205,8 +205,9 @@ std::size_t TsdfVolume::memoryBytes() const {
   return tsdf_->memUsage() + weight_->memUsage() + color_->memUsage() + free_->memUsage();
 }
 
-void TsdfVolume::writeVdb(const std::string& path) const {
-  openvdb::GridCPtrVec grids{votedTsdf(), weight_, color_};
+void TsdfVolume::writeVdb(const std::string& path,
+                          const openvdb::FloatGrid::ConstPtr& voted) const {
+  openvdb::GridCPtrVec grids{voted, weight_, color_};
   if (options_.free_votes) grids.push_back(free_);
   openvdb::io::File file(path);
   file.write(grids);

@@ -44,9 +44,13 @@ class TsdfVolume {
   void integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
                  const Eigen::Isometry3d& T_W_C);
   void reset();
-  /// Marching cubes (openvdb::tools::volumeToMesh) keeping cells whose 8 corners are observed.
-  PlyData extractMesh() const;
-  void writeVdb(const std::string& path) const;
+  /// tsdf with the voxels the free votes carve set to +1 (the tsdf itself without free_votes):
+  /// what both exports read, made once per export.
+  openvdb::FloatGrid::ConstPtr votedTsdf() const;
+  /// Marching cubes (openvdb::tools::volumeToMesh) of `voted` keeping cells whose 8 corners are
+  /// observed.
+  PlyData extractMesh(const openvdb::FloatGrid& voted) const;
+  void writeVdb(const std::string& path, const openvdb::FloatGrid::ConstPtr& voted) const;
   std::size_t activeVoxels() const { return tsdf_->activeVoxelCount(); }
   std::size_t memoryBytes() const;
 
@@ -58,8 +62,6 @@ class TsdfVolume {
   openvdb::FloatGrid::Ptr weight_;
   openvdb::Vec3SGrid::Ptr color_;
   openvdb::FloatGrid::Ptr free_;  ///< views that saw through each voxel (free_votes)
-  /// tsdf_ with the voxels the free votes carve set to +1 (tsdf_ itself without free_votes).
-  openvdb::FloatGrid::ConstPtr votedTsdf() const;
 };
 
 }  // namespace dynamap::plugin

@@ -71,7 +71,8 @@ class VdbTsdfBackend final : public MapBackend {
   void exportMap(const std::string& dir) override {
     namespace fs = std::filesystem;
     fs::create_directories(dir);
-    const PlyData mesh = volume_.extractMesh();
+    const openvdb::FloatGrid::ConstPtr voted = volume_.votedTsdf();
+    const PlyData mesh = volume_.extractMesh(*voted);
     const fs::path d(dir);
     // The text OBJ takes longest to write: on a thread of its own while the others are written.
     std::exception_ptr obj_error;
@@ -87,7 +88,7 @@ class VdbTsdfBackend final : public MapBackend {
       writeAtomically((d / "mesh.ply").string(),
                       [&](const std::string& tmp) { writePly(tmp, mesh); });
       writeAtomically((d / "tsdf.vdb").string(),
-                      [&](const std::string& tmp) { volume_.writeVdb(tmp); });
+                      [&](const std::string& tmp) { volume_.writeVdb(tmp, voted); });
     } catch (...) {
       obj.join();
       throw;
