@@ -63,6 +63,8 @@ void TsdfVolume::reset() {
   free_->setName("free_views");
 }
 
+// free_ holds, per voxel, the views that saw through it minus free_vote_ratio x the band weight
+// that max_weight cut off, so `free > ratio x weight` is `see-throughs > ratio x every band view`.
 openvdb::FloatGrid::ConstPtr TsdfVolume::votedTsdf() const {
   if (!options_.free_votes) return tsdf_;
   openvdb::FloatGrid::Ptr voted = tsdf_->deepCopy();
@@ -189,6 +191,10 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
             const float w_new = std::min(w_old + w, options_.max_weight);
             tl.setValueOn(n, (tl.getValue(n) * w_old + obs * w) / (w_old + w));
             wl.setValueOn(n, w_new);
+            if (fl != nullptr && w_old + w > w_new) {
+              // The weight stopped at max_weight; the vote still counts this view (see votedTsdf).
+              fl->setValueOn(n, fl->getValue(n) - options_.free_vote_ratio * (w_old + w - w_new));
+            }
             if (has_colour && std::fabs(sdf) < trunc) {
               const cv::Vec3b p = bgr.at<cv::Vec3b>(v, u);
               const openvdb::Vec3s c_new(p[2], p[1], p[0]);

@@ -17,7 +17,7 @@ namespace dynamap::plugin {
 struct TsdfOptions {
   double voxel_size_m = 0.02;
   double truncation_m = 0.08;
-  float max_weight = 100.0f;
+  float max_weight = 100.0f;      ///< the distance's weight stops here (free votes still count)
   float min_weight = 1.0f;        ///< export: every corner of a mesh cell needs this weight
   bool space_carving = true;      ///< visit existing blocks in front of the surface
   bool linear_weighting = false;  ///< weight falls off linearly behind the surface
