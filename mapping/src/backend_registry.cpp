@@ -26,6 +26,7 @@ class PluginBackend final : public MapBackend {
   void reset() override { inner_->reset(); }
   void exportMap(const std::string& dir) override { inner_->exportMap(dir); }
   MapStats stats() const override { return inner_->stats(); }
+  bool fusesViews() const override { return inner_->fusesViews(); }
 
  private:
   std::shared_ptr<void> handle_;

@@ -30,6 +30,7 @@ MappingWorker::MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeC
       capacity_(std::max<std::size_t>(1, queue_capacity)),
       timings_(timings) {
   if (!backend_) throw MappingError("MappingWorker: null backend");
+  if (backend_->fusesViews()) options_.mask_dilation_px = options_.fused_mask_dilation_px;
   thread_ = std::thread([this] { run(); });
 }
 

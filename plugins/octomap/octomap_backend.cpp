@@ -82,6 +82,7 @@ class OctomapBackend final : public MapBackend {
 
   void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
+  bool fusesViews() const override { return true; }
   void reset() override {
     if (pending_.valid()) pending_.get();
     tree_.clear();

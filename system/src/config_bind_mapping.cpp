@@ -9,6 +9,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.depth_min_m", &s.depth_min_m, 0.0, 100.0);
   schema.addDouble("mapping.depth_max_m", &s.depth_max_m, 0.0, 100.0);
   schema.addInt("mapping.mask_dilation_px", &s.mask_dilation_px, 0, 100);
+  schema.addInt("mapping.fused_mask_dilation_px", &s.fused_mask_dilation_px, 0, 100);
   schema.addDouble("mapping.depth_edge_threshold_m", &s.depth_edge_threshold_m, 0.0, 100.0);
   schema.addInt("mapping.stride", &s.stride, 1, 64);
   schema.addInt("mapping.mask_lookahead_frames", &c.mask_lookahead_frames, 0, 30);

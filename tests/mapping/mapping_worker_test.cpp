@@ -21,7 +21,8 @@ struct FakeLog {
 
 class FakeBackend final : public MapBackend {
  public:
-  FakeBackend(FakeLog* log, PoseUpdateMode mode) : log_(log), mode_(mode) {}
+  FakeBackend(FakeLog* log, PoseUpdateMode mode, bool fuses = false)
+      : log_(log), mode_(mode), fuses_(fuses) {}
   void integrate(const KeyframeView& view) override {
     std::unique_lock<std::mutex> lock(log_->mutex);
     log_->cv.wait(lock, [&] { return log_->released; });
@@ -37,10 +38,12 @@ class FakeBackend final : public MapBackend {
   void reset() override { ++log_->resets; }
   void exportMap(const std::string&) override {}
   MapStats stats() const override { return {}; }
+  bool fusesViews() const override { return fuses_; }
 
  private:
   FakeLog* log_;
   PoseUpdateMode mode_;
+  bool fuses_;
 };
 
 KeyframePacketPtr packet(std::uint64_t id) {
@@ -192,6 +195,28 @@ TEST(MappingWorker, DeferredIntegrationIntegratesEachKeyframeOnceWithItsFinalPos
   }
   EXPECT_EQ(points[1], points[0]);
   EXPECT_GT(points[1].front(), 1000u);
+}
+
+// A backend whose cells are votes over views gets the mask grown by fused_mask_dilation_px (3),
+// a point backend by mask_dilation_px (5): the fusing one receives the ring between them.
+TEST(MappingWorker, FusingBackendsGetTheNarrowerMaskMargin) {
+  const auto pointsFor = [](bool fuses, int fused_px) {
+    FakeLog log;
+    log.released = true;
+    StaticPointsOptions options = countingOptions();
+    options.deferred_integration = false;
+    options.fused_mask_dilation_px = fused_px;
+    MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace, fuses),
+                         SyntheticScene::camera(), options, 4, nullptr);
+    worker.push(packet(1));
+    worker.finish();
+    EXPECT_FALSE(log.points.empty());
+    return log.points.empty() ? std::size_t{0} : log.points.front();
+  };
+  ASSERT_GT(cv::countNonZero(packet(1)->dynamic_mask), 100) << "the scene lost its mover";
+  const std::size_t kept_points = pointsFor(false, 3), kept_fused = pointsFor(true, 3);
+  EXPECT_GT(kept_fused, kept_points + 50) << "the ring between 3 and 5 px reached neither";
+  EXPECT_EQ(pointsFor(true, 5), kept_points);
 }
 
 }  // namespace

@@ -67,6 +67,10 @@ class MapBackend {
   /// Throws MappingError on I/O failure.
   virtual void exportMap(const std::string& dir) = 0;
   virtual MapStats stats() const = 0;
+  /// true: each map cell is a vote over the views that saw it (a TSDF's weighted average,
+  /// occupancy log-odds), so a few stray pixels of one view are outvoted; false: every observed
+  /// point is kept. The worker grows dynamic masks less for a fusing backend.
+  virtual bool fusesViews() const { return false; }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).

@@ -17,7 +17,11 @@ namespace dynamap {
 struct StaticPointsOptions {
   double depth_min_m = 0.3;
   double depth_max_m = 4.0;
-  int mask_dilation_px = 5;              ///< dynamic mask grown by this radius (0 = as is)
+  int mask_dilation_px = 5;  ///< dynamic mask grown by this radius (0 = as is)
+  /// MappingWorker: the radius for a backend that fuses its views (MapBackend::fusesViews():
+  /// a TSDF's weights, occupancy's log-odds), where a mask rim's few pixels one view let through
+  /// are outvoted by the views that saw the space free; a point backend keeps every such point.
+  int fused_mask_dilation_px = 3;
   double depth_edge_threshold_m = 0.05;  ///< |depth jump| to a 4-neighbour marking an edge
   int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
   FreeSpaceOptions free_space;   ///< MappingWorker: drop pixels that violate neighbours' free space
