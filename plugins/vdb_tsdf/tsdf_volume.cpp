@@ -188,12 +188,13 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
             const float obs = std::min(1.0f, sdf / trunc);
             float w = 1.0f;
             if (options_.linear_weighting && sdf < 0.0f) w = std::max(0.05f, 1.0f + sdf / trunc);
-            const float w_new = std::min(w_old + w, options_.max_weight);
-            tl.setValueOn(n, (tl.getValue(n) * w_old + obs * w) / (w_old + w));
+            const float w_sum = w_old + w;
+            const float w_new = std::min(w_sum, options_.max_weight);
+            tl.setValueOn(n, (tl.getValue(n) * w_old + obs * w) / w_sum);
             wl.setValueOn(n, w_new);
-            if (fl != nullptr && w_old + w > w_new) {
+            if (fl != nullptr && w_sum > w_new) {
               // The weight stopped at max_weight; the vote still counts this view (see votedTsdf).
-              fl->setValueOn(n, fl->getValue(n) - options_.free_vote_ratio * (w_old + w - w_new));
+              fl->setValueOn(n, fl->getValue(n) - options_.free_vote_ratio * (w_sum - w_new));
             }
             if (has_colour && std::fabs(sdf) < trunc) {
               const cv::Vec3b p = bgr.at<cv::Vec3b>(v, u);

@@ -33,7 +33,7 @@ struct TsdfOptions {
 };
 
 /// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight = views within the
-/// truncation band, colour, and with free_votes the views that saw through), integrated
+/// truncation band, colour, and with free_votes the see-through votes), integrated
 /// projectively: the 8^3 leaf blocks within the truncation band of the observed depth (and, with
 /// space carving, existing blocks along the rays in front of it) are found from the depth image,
 /// then every voxel of those blocks is projected into the depth image (TBB over blocks).
@@ -61,7 +61,9 @@ class TsdfVolume {
   openvdb::FloatGrid::Ptr tsdf_;
   openvdb::FloatGrid::Ptr weight_;
   openvdb::Vec3SGrid::Ptr color_;
-  openvdb::FloatGrid::Ptr free_;  ///< views that saw through each voxel (free_votes)
+  /// free_votes: the views that saw through each voxel, less free_vote_ratio x the band weight
+  /// that max_weight cut off (see votedTsdf()).
+  openvdb::FloatGrid::Ptr free_;
 };
 
 }  // namespace dynamap::plugin

@@ -139,6 +139,9 @@ TEST(TsdfFreeVotes, FloorBehindAnEdgeSurvivesPoseErrors) {
   EXPECT_LE(averaged, voted - 0.03) << "the scene no longer shows what the votes are for";
 }
 
+// The bag of the tests below, on the floor.
+const Box kBag{{-1.35, -0.95, 0.0}, {-1.05, -0.65, 0.6}};
+
 // Mesh vertices inside (2 cm around) `box` higher than z above the floor.
 std::size_t above(const std::vector<Eigen::Vector3f>& mesh, const Box& box, float z) {
   std::size_t n = 0;
@@ -152,14 +155,13 @@ std::size_t above(const std::vector<Eigen::Vector3f>& mesh, const Box& box, floa
 // free_vote_ratio 1, as only some later views see through it).
 TEST(TsdfFreeVotes, ThingMostViewsSawThroughIsCarved) {
   if (!vdbBuilt()) GTEST_SKIP() << "vdb_tsdf backend not built";
-  const Box bag{{-1.35, -0.95, 0.0}, {-1.05, -0.65, 0.6}};
-  EXPECT_EQ(above(floorMesh(kDefaults, 10, 0.0, "bag1", &bag, 1), bag, 0.05f), 0u);
-  EXPECT_LE(above(floorMesh(kDefaults, 10, 0.0, "bag2", &bag, 2), bag, 0.05f), 50u);
-  const std::size_t whole = above(floorMesh(kDefaults, 10, 0.0, "bag10", &bag, 10), bag, 0.15f);
+  EXPECT_EQ(above(floorMesh(kDefaults, 10, 0.0, "bag1", &kBag, 1), kBag, 0.05f), 0u);
+  EXPECT_LE(above(floorMesh(kDefaults, 10, 0.0, "bag2", &kBag, 2), kBag, 0.05f), 50u);
+  const std::size_t whole = above(floorMesh(kDefaults, 10, 0.0, "bag10", &kBag, 10), kBag, 0.15f);
   EXPECT_GT(whole, 500u);
-  EXPECT_GT(above(floorMesh(kDefaults, 10, 0.0, "bag8", &bag, 8), bag, 0.15f), whole / 2);
+  EXPECT_GT(above(floorMesh(kDefaults, 10, 0.0, "bag8", &kBag, 8), kBag, 0.15f), whole / 2);
   const BackendParams no_carving = {{"voxel_size_m", "0.02"}, {"space_carving", "false"}};
-  EXPECT_GT(above(floorMesh(no_carving, 10, 0.0, "bag_kept", &bag, 1), bag, 0.15f), 100u)
+  EXPECT_GT(above(floorMesh(no_carving, 10, 0.0, "bag_kept", &kBag, 1), kBag, 0.15f), 100u)
       << "the first view did not put the bag into the volume";
 }
 
@@ -170,14 +172,14 @@ TEST(TsdfFreeVotes, ThingMostViewsSawThroughIsCarved) {
 // (measured: 652 / 1688 vertices vs 636 / 1677; against the capped weight, as before, 361 / 1098).
 TEST(TsdfFreeVotes, BandViewsPastMaxWeightStillCount) {
   if (!vdbBuilt()) GTEST_SKIP() << "vdb_tsdf backend not built";
-  const Box bag{{-1.35, -0.95, 0.0}, {-1.05, -0.65, 0.6}};
   const BackendParams capped = {{"voxel_size_m", "0.02"}, {"max_weight", "2"}};
-  const double whole = above(floorMesh(kDefaults, 10, 0.0, "cap_whole", &bag, 10), bag, 0.15f);
+  const double whole = above(floorMesh(kDefaults, 10, 0.0, "cap_whole", &kBag, 10), kBag, 0.15f);
   ASSERT_GT(whole, 500.0);
   for (const int views : {4, 6}) {
     const std::string name = "cap" + std::to_string(views);
-    const double n_capped = above(floorMesh(capped, 10, 0.0, name, &bag, views), bag, 0.15f);
-    const double n_free = above(floorMesh(kDefaults, 10, 0.0, name + "u", &bag, views), bag, 0.15f);
+    const double n_capped = above(floorMesh(capped, 10, 0.0, name, &kBag, views), kBag, 0.15f);
+    const double n_free =
+        above(floorMesh(kDefaults, 10, 0.0, name + "u", &kBag, views), kBag, 0.15f);
     EXPECT_NEAR(n_capped, n_free, 0.05 * whole) << "bag in the first " << views << " views";
   }
 }
