@@ -83,14 +83,22 @@ keys = [("masks", "mean_iou", "IoU"), ("masks", "pixel_recall", "recall"),
         ("masks", "pixel_precision", "precision"), ("masks", "standing_masked_share", "standing"),
         ("map", "precision", "map_prec"), ("map", "completeness", "map_comp"),
         ("map", "ghost_ratio", "ghost_%"), ("map", "ghost_fragments", "fragments")]
-print("%-6s %3s" % ("masks", "n") + "".join(" %9s" % k[2] for k in keys))
+print("%-9s %3s" % ("masks", "n") + "".join(" %9s" % k[2] for k in keys))
+def show(label, rows):
+    if rows:
+        means = [sum(c) / len(rows) for c in zip(*rows)]
+        print("%-9s %3d" % (label, len(rows)) + "".join(" %9.3f" % v for v in means))
 for name in names:
-    rows = []
+    rows, by_stride = [], {}
     for path in sorted(glob.glob("%s/run_%s_*/metrics.json" % (out, name))):
         m = json.load(open(path))
         if "masks" in m and "map" in m:
-            rows.append([m[a][b] * (100 if b == "ghost_ratio" else 1) for a, b, _ in keys])
-    if rows:
-        means = [sum(c) / len(rows) for c in zip(*rows)]
-        print("%-6s %3d" % (name, len(rows)) + "".join(" %9.3f" % v for v in means))
+            row = [m[a][b] * (100 if b == "ghost_ratio" else 1) for a, b, _ in keys]
+            rows.append(row)
+            by_stride.setdefault(path.split("/")[-2].split("_")[-1], []).append(row)
+    show(name, rows)
+    # Per stride as well: a stride of 2 doubles every motion between frames (and the ground
+    # truth's jitter, with which the semi-synthetic people are drawn).
+    for stride in sorted(by_stride, key=int) if len(by_stride) > 1 else []:
+        show("%s/%s" % (name, stride), by_stride[stride])
 PY
