@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""Where a run's keyframe masks go wrong, against a semi-synthetic sequence's ground-truth masks.
+
+usage: scripts/mask_errors.py SEQ RUN [--per-keyframe]
+  SEQ: the sequence folder (mask/<stamp>.png: 255 moving person, 128 standing person, 0 scene)
+  RUN: a `dynamap run ... --save-masks` output folder (masks/<stamp>.png, 255 = masked)
+
+Prints the pooled IoU / recall / precision / standing share (as `dynamap run` computes them),
+the same with the masks eroded by 1-3 px (what the masks' margins cost), and the false-positive
+pixels split by what they are: the standing person, or scene pixels at a given distance from the
+nearest moving-person pixel (beyond 30 px, with and without depth).
+"""
+import os
+import sys
+
+import cv2
+import numpy as np
+
+
+def stamps_to_files(seq, listing):
+    out = {}
+    for line in open(os.path.join(seq, listing)):
+        if not line.startswith("#") and line.strip():
+            t, f = line.split()[:2]
+            out[float(t)] = f
+    return out
+
+
+def nearest(table, t):
+    return table[min(table, key=lambda k: abs(k - t))]
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    seq, run = sys.argv[1], sys.argv[2]
+    per_keyframe = "--per-keyframe" in sys.argv
+    depths = stamps_to_files(seq, "depth.txt")
+    names = sorted(os.listdir(os.path.join(run, "masks")))
+    frames = []
+    for name in names:
+        pred = cv2.imread(os.path.join(run, "masks", name), cv2.IMREAD_GRAYSCALE) > 127
+        gt = cv2.imread(os.path.join(seq, "mask", name), cv2.IMREAD_GRAYSCALE)
+        depth = cv2.imread(os.path.join(seq, nearest(depths, float(name[:-4]))), cv2.IMREAD_UNCHANGED)
+        frames.append((name[:-4], pred, gt == 255, gt == 128, depth))
+
+    for r in (0, 1, 2, 3):
+        tp = fp = fn = st = stm = 0
+        ious = []
+        for stamp, pred, moving, standing, _ in frames:
+            p = pred
+            if r:
+                kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+                p = cv2.erode(pred.astype(np.uint8), kernel) > 0
+            a, b, c = (p & moving).sum(), (p & ~moving).sum(), (~p & moving).sum()
+            if moving.any():
+                ious.append(a / max(1, (p | moving).sum()))
+            tp, fp, fn = tp + a, fp + b, fn + c
+            st, stm = st + standing.sum(), stm + (p & standing).sum()
+            if per_keyframe and r == 0:
+                print("%s IoU %.3f recall %.3f precision %.3f standing %d of %d" %
+                      (stamp, ious[-1] if moving.any() else 0, a / max(1, moving.sum()),
+                       a / max(1, p.sum()), (p & standing).sum(), standing.sum()))
+        print("eroded %d px: IoU %.3f recall %.3f precision %.3f standing masked %.1f %%" %
+              (r, np.mean(ious), tp / max(1, tp + fn), tp / max(1, tp + fp), 100 * stm / max(1, st)))
+
+    bins = ["the standing person", "<= 3 px from a moving person", "4-10 px", "11-30 px",
+            "> 30 px, no depth", "> 30 px"]
+    counts = np.zeros(len(bins))
+    tp = 0
+    for _, pred, moving, standing, depth in frames:
+        fp = pred & ~moving
+        dist = cv2.distanceTransform((~moving).astype(np.uint8), cv2.DIST_L2, 3)
+        scene = fp & ~standing
+        counts += [(fp & standing).sum(), (scene & (dist <= 3)).sum(),
+                   (scene & (dist > 3) & (dist <= 10)).sum(), (scene & (dist > 10) & (dist <= 30)).sum(),
+                   (scene & (dist > 30) & (depth == 0)).sum(), (scene & (dist > 30) & (depth > 0)).sum()]
+        tp += (pred & moving).sum()
+    total = counts.sum()
+    print("false positives: %d pixels (precision %.3f)" % (total, tp / max(1, tp + total)))
+    for name, c in zip(bins, counts):
+        print("  %-30s %9d %5.1f %%  precision without them %.3f" %
+              (name, c, 100 * c / max(1, total), tp / max(1, tp + total - c)))
+
+
+if __name__ == "__main__":
+    main()
