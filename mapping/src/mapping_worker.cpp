@@ -192,6 +192,11 @@ bool MappingWorker::removeSeenThroughLocked() {
   visibility_ = removeSeenThrough(camera_, keyframes, options_.visibility);
   if (timings_ != nullptr) {
     for (const double ms : visibility_.per_keyframe_ms) timings_->add("mapping_visibility_kf", ms);
+    timings_->add("mapping_visibility_key", visibility_.key_ms);
+    timings_->add("mapping_visibility_add", visibility_.add_ms);
+    timings_->add("mapping_visibility_project", visibility_.project_ms);
+    timings_->add("mapping_visibility_verdict", visibility_.verdict_ms);
+    timings_->add("mapping_visibility_zero", visibility_.zero_ms);
   }
   return visibility_.removed_pixels > 0;
 }

@@ -5,11 +5,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
-#include <unordered_set>
 
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/mapping/flat_index.hpp"
 #include "dynamap/mapping/radix_sort.hpp"
 #include "in_two.hpp"
 #include "plane_fit.hpp"
@@ -56,16 +55,38 @@ std::uint64_t offsetKey(std::uint64_t key, int dx, int dy, int dz) {
 
 /// A keyframe's static points in runs of consecutive points of one voxel (neighbouring pixels of
 /// a row mostly share a 2 cm voxel), the runs sorted by voxel key, then by their first point.
+/// ordinal: the run's place in point order; starts[ordinal]: its first point.
 struct VoxelRun {
   std::uint64_t key = 0;
-  std::uint32_t first = 0;
+  std::uint32_t ordinal = 0;
   std::uint32_t count = 0;
 };
 struct KeyedPoints {
   std::vector<VoxelRun> runs;
   std::vector<VoxelRun> scratch;  ///< for the sort
+  std::vector<std::uint32_t> starts;
   std::vector<Eigen::Vector3f> points;
 };
+
+/// A keyframe's runs in point order: each run's element and length. The removal walks the
+/// keyframe's static pixels with them instead of keying every point again.
+struct RunElements {
+  std::vector<std::uint32_t> element;
+  std::vector<std::uint32_t> count;
+};
+
+/// Runs fn(depth) for every static pixel of a keyframe, in the order forEachStaticPoint() takes.
+template <typename T, typename Fn>
+void forEachStaticPixelT(const VisibilityKeyframe& kf, const Fn& fn) {
+  cv::Mat& depth = *kf.static_depth;
+  const auto scale = static_cast<float>(kf.metres_per_unit);
+  for (int v = 0; v < depth.rows; ++v) {
+    T* row = depth.ptr<T>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (static_cast<float>(row[u]) * scale > 0.0f) fn(row[u]);
+    }
+  }
+}
 
 /// Runs fn(depth, u, v, p_W) for every static pixel of a keyframe.
 template <typename T, typename Fn>
@@ -105,6 +126,7 @@ class ElementTable {
   void keyPoints(const PinholeCamera& camera, const VisibilityKeyframe& kf,
                  KeyedPoints& out) const {
     out.runs.clear();
+    out.starts.clear();
     out.points.clear();
     forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
       const std::uint64_t key = voxelKey(p_W, inv_voxel_);
@@ -113,7 +135,8 @@ class ElementTable {
       if (!out.runs.empty() && out.runs.back().key == key) {
         ++out.runs.back().count;
       } else {
-        out.runs.push_back({key, index, 1});
+        out.runs.push_back({key, static_cast<std::uint32_t>(out.starts.size()), 1});
+        out.starts.push_back(index);
       }
     });
     // Made in point order: a stable sort by voxel gives (key, first) order.
@@ -121,18 +144,27 @@ class ElementTable {
   }
 
   /// Adds a keyframe's keyed points, point by point in (voxel, point) order: one hash access per
-  /// distinct voxel. Keyframes must be added in the same order on every run (the element order
-  /// and the float sums depend on it).
-  void add(const KeyedPoints& in) {
+  /// distinct voxel; `out` gets each run's element in point order. Keyframes must be added in the
+  /// same order on every run (the element order and the float sums depend on it).
+  void add(const KeyedPoints& in, RunElements& out) {
     const auto& runs = in.runs;
+    out.element.resize(runs.size());
+    out.count.resize(runs.size());
     for (std::size_t b = 0; b < runs.size();) {
-      const auto [it, inserted] =
-          index_.try_emplace(runs[b].key, static_cast<std::uint32_t>(elements_.size()));
-      if (inserted) elements_.emplace_back();
-      Element& e = elements_[it->second];
-      for (; b < runs.size() && runs[b].key == it->first; ++b) {
-        for (std::uint32_t i = 0; i < runs[b].count; ++i) e.sum += in.points[runs[b].first + i];
+      const std::uint64_t key = runs[b].key;
+      const auto [i, inserted] =
+          index_.tryEmplace(key, static_cast<std::uint32_t>(elements_.size()));
+      if (inserted) {
+        elements_.emplace_back();
+        keys_.push_back(key);
+      }
+      Element& e = elements_[i];
+      for (; b < runs.size() && runs[b].key == key; ++b) {
+        const std::uint32_t first = in.starts[runs[b].ordinal];
+        for (std::uint32_t p = 0; p < runs[b].count; ++p) e.sum += in.points[first + p];
         e.count += runs[b].count;
+        out.element[runs[b].ordinal] = i;
+        out.count[runs[b].ordinal] = runs[b].count;
       }
     }
   }
@@ -183,18 +215,18 @@ class ElementTable {
     }
   }
 
-  /// Keys of the removed elements (a small set: fast lookups for every pixel); counts those
-  /// removed by mask votes only. stamps: the keyframes' times (s), in view order.
-  std::unordered_set<std::uint64_t> removedKeys(const PinholeCamera& camera,
-                                                const std::vector<VisibilityKeyframe>& keyframes,
-                                                const VisibilityOptions& options,
-                                                const std::vector<double>& stamps,
-                                                std::size_t* mask_voted) const {
+  /// Per element, 1 if it is removed; counts the removed ones and those removed by mask votes
+  /// only. stamps: the keyframes' times (s), in view order.
+  std::vector<std::uint8_t> removedElements(const PinholeCamera& camera,
+                                            const std::vector<VisibilityKeyframe>& keyframes,
+                                            const VisibilityOptions& options,
+                                            const std::vector<double>& stamps,
+                                            std::size_t* removed, std::size_t* mask_voted) const {
     const BesideMover beside(camera, keyframes, options, stamps);
-    std::unordered_set<std::uint64_t> keys;
+    std::vector<std::uint8_t> out(elements_.size(), 0);
     std::vector<Verdict> verdicts(elements_.size(), Verdict::kKept);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> brief;
-    for (const auto& [key, i] : index_) {
+    for (std::uint32_t i = 0; i < elements_.size(); ++i) {
       const Element& e = elements_[i];
       const bool seen_through =
           e.seen_through >= static_cast<std::uint32_t>(std::max(1, options.min_views));
@@ -202,11 +234,12 @@ class ElementTable {
                          e.masked >= options.mask_ratio * e.observed;
       if (seen_through || voted) {
         verdicts[i] = Verdict::kRemoved;
-        keys.insert(key);
+        out[i] = 1;
+        ++*removed;
         if (!seen_through) ++*mask_voted;
       } else if (briefUnderMask(e, options, stamps) || beside.holds(e, centroids_[i])) {
         verdicts[i] = Verdict::kBrief;
-        brief.emplace_back(key, i);
+        brief.emplace_back(keys_[i], i);
       }
     }
     // The plane test reads only: the candidates in two halves, one per thread.
@@ -219,12 +252,12 @@ class ElementTable {
     });
     for (std::size_t b = 0; b < brief.size(); ++b) {
       if (spared[b]) continue;
-      keys.insert(brief[b].first);
+      out[brief[b].second] = 1;
+      ++*removed;
       ++*mask_voted;
     }
-    return keys;
+    return out;
   }
-  std::uint64_t key(const Eigen::Vector3f& p_W) const { return voxelKey(p_W, inv_voxel_); }
 
   /// Whether element i lies on a plane that the kept elements around it (within
   /// kSupportRadiusM, seen by 2 keyframes or more, none of them a brief vote) span: the floor
@@ -237,9 +270,8 @@ class ElementTable {
     for (int dz = -reach; dz <= reach; ++dz) {
       for (int dy = -reach; dy <= reach; ++dy) {
         for (int dx = -reach; dx <= reach; ++dx) {
-          const auto it = index_.find(offsetKey(key, dx, dy, dz));
-          if (it == index_.end() || it->second == i) continue;
-          const std::uint32_t j = it->second;
+          const std::uint32_t j = index_.find(offsetKey(key, dx, dy, dz));
+          if (j == FlatIndex::kMissing || j == i) continue;
           if (verdicts[j] == Verdict::kKept && elements_[j].observed >= 2)
             support.push_back(centroids_[j]);
         }
@@ -249,18 +281,42 @@ class ElementTable {
   }
   std::size_t size() const { return elements_.size(); }
   std::size_t bytes() const {
-    const std::size_t node = sizeof(std::uint64_t) + sizeof(std::uint32_t) + 2 * sizeof(void*);
     return elements_.capacity() * sizeof(Element) +
-           centroids_.capacity() * sizeof(Eigen::Vector3f) + index_.size() * node +
-           index_.bucket_count() * sizeof(void*);
+           centroids_.capacity() * sizeof(Eigen::Vector3f) +
+           keys_.capacity() * sizeof(std::uint64_t) + index_.bytes();
   }
 
  private:
   float inv_voxel_;
-  std::unordered_map<std::uint64_t, std::uint32_t> index_;
+  FlatIndex index_;
+  std::vector<std::uint64_t> keys_;  ///< element i's voxel key
   std::vector<Element> elements_;
   std::vector<Eigen::Vector3f> centroids_;
 };
+
+/// Zeroes a keyframe's static pixels whose run's element is removed; returns their number.
+std::size_t zeroRemoved(const VisibilityKeyframe& kf, const RunElements& runs,
+                        const std::vector<std::uint8_t>& removed) {
+  std::size_t run = 0, left = 0, zeroed = 0;
+  bool zero = false;
+  const auto fn = [&](auto& depth) {
+    while (left == 0) {  // the pixels come in point order: the runs cover them one by one
+      zero = removed[runs.element[run]] != 0;
+      left = runs.count[run++];
+    }
+    --left;
+    if (zero) {
+      depth = 0;
+      ++zeroed;
+    }
+  };
+  if (kf.static_depth->type() == CV_16UC1) {
+    forEachStaticPixelT<std::uint16_t>(kf, fn);
+  } else {
+    forEachStaticPixelT<float>(kf, fn);
+  }
+  return zeroed;
+}
 
 }  // namespace
 
@@ -301,7 +357,9 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
   ElementTable table(options.voxel_m);
   // Keyframes are keyed two at a time (one per thread) and added in their order.
   KeyedPoints keyed[2];
+  std::vector<RunElements> runs(n);  // each keyframe's runs, for the removal
   for (std::size_t i = 0; i < n; i += 2) {
+    const auto t_key = Clock::now();
     inTwo([&](int h) {
       const std::size_t k = i + static_cast<std::size_t>(h);
       if (k >= n || keyframes[k].static_depth == nullptr) return;
@@ -309,15 +367,19 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
       table.keyPoints(camera, keyframes[k], keyed[h]);
       ms[h][k] += msSince(t0);
     });
+    const auto t_add = Clock::now();
+    result.key_ms += msSince(t_key);
     for (int h = 0; h < 2; ++h) {
       const std::size_t k = i + static_cast<std::size_t>(h);
       if (k >= n || keyframes[k].static_depth == nullptr) continue;
       const auto t0 = Clock::now();
-      table.add(keyed[h]);
+      table.add(keyed[h], runs[k]);
       ms[h][k] += msSince(t0);
     }
+    result.add_ms += msSince(t_add);
   }
   keyed[0] = keyed[1] = KeyedPoints{};
+  auto t_phase = Clock::now();
   table.computeCentroids();
   const std::size_t half = table.size() / 2;
   inTwo([&](int h) {  // each half of the elements against every view
@@ -330,37 +392,31 @@ VisibilityResult removeSeenThrough(const PinholeCamera& camera,
       ms[h][j] += msSince(t0);
     }
   });
+  result.project_ms = msSince(t_phase);
+  t_phase = Clock::now();
   result.elements = table.size();
   std::vector<double> stamps(n);
   for (std::size_t i = 0; i < n; ++i) stamps[i] = keyframes[i].timestamp_s;
-  const std::unordered_set<std::uint64_t> removed =
-      table.removedKeys(camera, keyframes, options, stamps, &result.mask_voted);
-  result.seen_through = removed.size() - result.mask_voted;
+  std::size_t removed_elements = 0;
+  const std::vector<std::uint8_t> removed = table.removedElements(
+      camera, keyframes, options, stamps, &removed_elements, &result.mask_voted);
+  result.seen_through = removed_elements - result.mask_voted;
   result.element_bytes = table.bytes();
-  if (!removed.empty()) {
+  result.verdict_ms = msSince(t_phase);
+  t_phase = Clock::now();
+  if (removed_elements > 0) {
     std::size_t removed_pixels[2] = {0, 0};
     inTwo([&](int h) {  // every other keyframe: each thread writes only its keyframes' depth
       for (std::size_t i = static_cast<std::size_t>(h); i < n; i += 2) {
         if (keyframes[i].static_depth == nullptr) continue;
         const auto t0 = Clock::now();
-        std::uint64_t last_key = 0;  // neighbouring pixels mostly share a voxel: one lookup
-        bool last_removed = false, any = false;
-        forEachStaticPoint(camera, keyframes[i], [&](auto& depth, const Eigen::Vector3f& p_W) {
-          const std::uint64_t key = table.key(p_W);
-          if (!any || key != last_key) {
-            last_key = key, any = true;
-            last_removed = removed.count(key) != 0;
-          }
-          if (last_removed) {
-            depth = 0;
-            ++removed_pixels[h];
-          }
-        });
+        removed_pixels[h] += zeroRemoved(keyframes[i], runs[i], removed);
         ms[h][i] += msSince(t0);
       }
     });
     result.removed_pixels = removed_pixels[0] + removed_pixels[1];
   }
+  result.zero_ms = msSince(t_phase);
   result.per_keyframe_ms.resize(n);
   for (std::size_t i = 0; i < n; ++i) result.per_keyframe_ms[i] = ms[0][i] + ms[1][i];
   return result;
