@@ -40,7 +40,9 @@ class FlatIndex {
   }
 
   std::size_t size() const { return size_; }
-  std::size_t bytes() const { return keys_.capacity() * sizeof(std::uint64_t) + values_.capacity() * sizeof(std::uint32_t); }
+  std::size_t bytes() const {
+    return keys_.capacity() * sizeof(std::uint64_t) + values_.capacity() * sizeof(std::uint32_t);
+  }
 
  private:
   static std::size_t capacityFor(std::size_t expected) {

@@ -86,9 +86,10 @@ struct VisibilityResult {
 /// keyframes must come in time order), and one that a single keyframe saw beside a mover
 /// (options.mask_near_px). Anything that every visit saw (a
 /// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
-/// point pairs. Runs on two threads (keyframes keyed two at a time and added in their order,
-/// elements split in halves, removal split by keyframe): the result does not depend on the
-/// threads. per_keyframe_ms is CPU time. Thread-safe for distinct keyframes (modifies only their
+/// point pairs. Runs on two threads (keyframes keyed four at a time, whichever thread is free,
+/// and added in their order; the element table in two parts by the parity of the voxel key,
+/// each filled, projected and judged by one thread; removal split by keyframe, walking each
+/// keyframe's runs of one voxel as keyed): the result does not depend on the threads. per_keyframe_ms is CPU time. Thread-safe for distinct keyframes (modifies only their
 /// depth images).
 VisibilityResult removeSeenThrough(const PinholeCamera& camera,
                                    std::vector<VisibilityKeyframe>& keyframes,
