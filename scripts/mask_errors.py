@@ -1,14 +1,16 @@
 #!/usr/bin/python3
 """Where a run's keyframe masks go wrong, against a semi-synthetic sequence's ground-truth masks.
 
-usage: scripts/mask_errors.py SEQ RUN [--per-keyframe]
+usage: scripts/mask_errors.py SEQ RUN [--per-keyframe] [--picture OUT.jpg]
   SEQ: the sequence folder (mask/<stamp>.png: 255 moving person, 128 standing person, 0 scene)
   RUN: a `dynamap run ... --save-masks` output folder (masks/<stamp>.png, 255 = masked)
 
 Prints the pooled IoU / recall / precision / standing share (as `dynamap run` computes them),
 the same with the masks eroded by 1-3 px (what the masks' margins cost), and the false-positive
 pixels split by what they are: the standing person, or scene pixels at a given distance from the
-nearest moving-person pixel (beyond 30 px, with and without depth).
+nearest moving-person pixel (beyond 30 px, with and without depth). --picture writes the six
+keyframes with the most false positives beyond 30 px: green masked mover, red masked scene or
+standing person, blue missed mover, yellow outline the standing person.
 """
 import os
 import sys
@@ -81,6 +83,32 @@ def main():
     for name, c in zip(bins, counts):
         print("  %-30s %9d %5.1f %%  precision without them %.3f" %
               (name, c, 100 * c / max(1, total), tp / max(1, tp + total - c)))
+    if "--picture" in sys.argv:
+        picture(seq, frames, sys.argv[sys.argv.index("--picture") + 1])
+
+
+def picture(seq, frames, out):
+    rgbs = stamps_to_files(seq, "rgb.txt")
+    far = []
+    for stamp, pred, moving, standing, _ in frames:
+        dist = cv2.distanceTransform((~moving).astype(np.uint8), cv2.DIST_L2, 3)
+        far.append(((pred & ~moving & ~standing & (dist > 30)).sum(), stamp, pred, moving, standing))
+    far.sort(key=lambda f: -f[0])
+    tiles = []
+    for n, stamp, pred, moving, standing in far[:6]:
+        img = cv2.imread(os.path.join(seq, nearest(rgbs, float(stamp))))
+        for sel, colour in ((pred & moving, (0, 127, 0)), (pred & ~moving, (0, 0, 127)),
+                            (~pred & moving, (127, 0, 0))):
+            img[sel] = (0.5 * img[sel] + colour).astype(np.uint8)
+        outline, _ = cv2.findContours(standing.astype(np.uint8), cv2.RETR_EXTERNAL,
+                                      cv2.CHAIN_APPROX_SIMPLE)
+        cv2.drawContours(img, outline, -1, (0, 255, 255), 2)
+        cv2.putText(img, "%s: %d px beyond 30 px" % (stamp, n), (8, 24), 0, 0.7, (255, 255, 255), 2)
+        tiles.append(cv2.resize(img, (480, 360)))
+    while len(tiles) % 3:
+        tiles.append(np.zeros_like(tiles[0]))
+    rows = [np.hstack(tiles[i:i + 3]) for i in range(0, len(tiles), 3)]
+    cv2.imwrite(out, np.vstack(rows), [cv2.IMWRITE_JPEG_QUALITY, 80])
 
 
 if __name__ == "__main__":
