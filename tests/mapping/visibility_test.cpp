@@ -237,5 +237,42 @@ TEST(Visibility, TwoThreadsGiveTheSameResultEveryTime) {
   }
 }
 
+// A keyframe without static depth (nullptr) gives no points but still votes with its view: the
+// same edits and counts as a keyframe whose static depth is all zero. 9 keyframes: the pass keys
+// them four at a time, so the batches are 4, 4 and 1.
+TEST(Visibility, AKeyframeWithoutStaticDepthOnlyVotes) {
+  const PinholeCamera cam = SyntheticScene::camera();
+  const SyntheticScene scene;
+  constexpr int kKeyframes = 9, kWithout = 5;
+  VisibilityOptions options;
+  std::vector<SyntheticFrame> frames;
+  std::vector<VisibilityView> views;
+  for (int k = 0; k < kKeyframes; ++k) {
+    frames.push_back(
+        scene.render(k, kKeyframes, k < 2 ? boxAt(0) : Box{{9, 9, 9}, {9.1, 9.1, 9.1}}));
+  }
+  for (const auto& f : frames) views.push_back(makeVisibilityView(f.depth_m, cv::Mat(), options));
+  const auto pass = [&](std::vector<cv::Mat>& depths, bool null_depth) {
+    depths.clear();
+    for (const auto& f : frames) depths.push_back(f.depth_m.clone());
+    depths[kWithout].setTo(0.0f);
+    std::vector<VisibilityKeyframe> kfs;
+    for (int k = 0; k < kKeyframes; ++k)
+      kfs.push_back({&depths[k], 1.0, frames[k].T_W_C, &views[k]});
+    if (null_depth) kfs[kWithout].static_depth = nullptr;
+    return removeSeenThrough(cam, kfs, options);
+  };
+  std::vector<cv::Mat> with_null, with_zeros;
+  const VisibilityResult a = pass(with_null, true), b = pass(with_zeros, false);
+  EXPECT_EQ(a.elements, b.elements);
+  EXPECT_EQ(a.seen_through, b.seen_through);
+  EXPECT_EQ(a.mask_voted, b.mask_voted);
+  EXPECT_EQ(a.removed_pixels, b.removed_pixels);
+  EXPECT_GT(a.removed_pixels, 200u);  // the box of the first two keyframes
+  for (int k = 0; k < kKeyframes; ++k) {
+    EXPECT_EQ(cv::countNonZero(with_null[k] != with_zeros[k]), 0) << k;
+  }
+}
+
 }  // namespace
 }  // namespace dynamap::test
