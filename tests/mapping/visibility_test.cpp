@@ -198,42 +198,52 @@ TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {
   EXPECT_EQ(r.per_keyframe_ms.size(), 3u);
 }
 
+/// n keyframes of the room: the floating box where it first stood, unmasked, in the first two,
+/// far away in the others. pass() runs copies of their depth through the visibility pass, after
+/// `edit` had its say on the depths and the keyframes.
+struct BoxInFirstTwo {
+  explicit BoxInFirstTwo(int n) {
+    const SyntheticScene scene;
+    for (int k = 0; k < n; ++k)
+      frames.push_back(scene.render(k, n, k < 2 ? boxAt(0) : Box{{9, 9, 9}, {9.1, 9.1, 9.1}}));
+    for (const auto& f : frames) views.push_back(makeVisibilityView(f.depth_m, cv::Mat(), options));
+  }
+  template <typename Edit>
+  VisibilityResult pass(std::vector<cv::Mat>& depths, const Edit& edit) const {
+    depths.clear();
+    for (const auto& f : frames) depths.push_back(f.depth_m.clone());
+    std::vector<VisibilityKeyframe> kfs;
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      kfs.push_back({&depths[k], 1.0, frames[k].T_W_C, &views[k]});
+    edit(depths, kfs);
+    return removeSeenThrough(SyntheticScene::camera(), kfs, options);
+  }
+  VisibilityOptions options;
+  std::vector<SyntheticFrame> frames;
+  std::vector<VisibilityView> views;
+};
+
 // The pass splits its work over two threads: an odd number of keyframes (the last pair has one)
 // gives the same edits and counts on every call, and a box left unmasked in the first keyframes
 // is removed from each of them.
 TEST(Visibility, TwoThreadsGiveTheSameResultEveryTime) {
-  const PinholeCamera cam = SyntheticScene::camera();
-  const SyntheticScene scene;
   constexpr int kKeyframes = 5;
-  VisibilityOptions options;
-  std::vector<SyntheticFrame> frames;
-  std::vector<VisibilityView> views;
-  for (int k = 0; k < kKeyframes; ++k) {
-    frames.push_back(
-        scene.render(k, kKeyframes, k < 2 ? boxAt(0) : Box{{9, 9, 9}, {9.1, 9.1, 9.1}}));
-  }
-  for (const auto& f : frames) views.push_back(makeVisibilityView(f.depth_m, cv::Mat(), options));
-  const auto pass = [&](std::vector<cv::Mat>& depths) {
-    depths.clear();
-    for (const auto& f : frames) depths.push_back(f.depth_m.clone());
-    std::vector<VisibilityKeyframe> kfs;
-    for (int k = 0; k < kKeyframes; ++k)
-      kfs.push_back({&depths[k], 1.0, frames[k].T_W_C, &views[k]});
-    return removeSeenThrough(cam, kfs, options);
-  };
+  const BoxInFirstTwo scene(kKeyframes);
+  const auto as_is = [](auto&, auto&) {};
   std::vector<cv::Mat> first, second;
-  const VisibilityResult a = pass(first), b = pass(second);
+  const VisibilityResult a = scene.pass(first, as_is), b = scene.pass(second, as_is);
   EXPECT_EQ(a.elements, b.elements);
   EXPECT_EQ(a.seen_through, b.seen_through);
   EXPECT_EQ(a.removed_pixels, b.removed_pixels);
   ASSERT_EQ(a.per_keyframe_ms.size(), static_cast<std::size_t>(kKeyframes));
   for (int k = 0; k < kKeyframes; ++k) EXPECT_EQ(cv::countNonZero(first[k] != second[k]), 0) << k;
   for (int k = 0; k < 2; ++k) {
-    const int box_px = cv::countNonZero(frames[k].mask);
+    const SyntheticFrame& f = scene.frames[k];
+    const int box_px = cv::countNonZero(f.mask);
     ASSERT_GT(box_px, 200);
-    const cv::Mat removed = (first[k] == 0) & (frames[k].depth_m > 0);
-    EXPECT_GT(cv::countNonZero(removed & frames[k].mask), 0.9 * box_px) << k;
-    EXPECT_LT(cv::countNonZero(removed & ~frames[k].mask), 0.02 * box_px) << k;
+    const cv::Mat removed = (first[k] == 0) & (f.depth_m > 0);
+    EXPECT_GT(cv::countNonZero(removed & f.mask), 0.9 * box_px) << k;
+    EXPECT_LT(cv::countNonZero(removed & ~f.mask), 0.02 * box_px) << k;
   }
 }
 
@@ -241,29 +251,16 @@ TEST(Visibility, TwoThreadsGiveTheSameResultEveryTime) {
 // same edits and counts as a keyframe whose static depth is all zero. 9 keyframes: the pass keys
 // them four at a time, so the batches are 4, 4 and 1.
 TEST(Visibility, AKeyframeWithoutStaticDepthOnlyVotes) {
-  const PinholeCamera cam = SyntheticScene::camera();
-  const SyntheticScene scene;
-  constexpr int kKeyframes = 9, kWithout = 5;
-  VisibilityOptions options;
-  std::vector<SyntheticFrame> frames;
-  std::vector<VisibilityView> views;
-  for (int k = 0; k < kKeyframes; ++k) {
-    frames.push_back(
-        scene.render(k, kKeyframes, k < 2 ? boxAt(0) : Box{{9, 9, 9}, {9.1, 9.1, 9.1}}));
-  }
-  for (const auto& f : frames) views.push_back(makeVisibilityView(f.depth_m, cv::Mat(), options));
-  const auto pass = [&](std::vector<cv::Mat>& depths, bool null_depth) {
-    depths.clear();
-    for (const auto& f : frames) depths.push_back(f.depth_m.clone());
-    depths[kWithout].setTo(0.0f);
-    std::vector<VisibilityKeyframe> kfs;
-    for (int k = 0; k < kKeyframes; ++k)
-      kfs.push_back({&depths[k], 1.0, frames[k].T_W_C, &views[k]});
-    if (null_depth) kfs[kWithout].static_depth = nullptr;
-    return removeSeenThrough(cam, kfs, options);
-  };
+  constexpr int kKeyframes = 9;
+  static constexpr int kWithout = 5;
+  const BoxInFirstTwo scene(kKeyframes);
   std::vector<cv::Mat> with_null, with_zeros;
-  const VisibilityResult a = pass(with_null, true), b = pass(with_zeros, false);
+  const VisibilityResult a = scene.pass(with_null, [](auto& depths, auto& kfs) {
+    depths[kWithout].setTo(0.0f);
+    kfs[kWithout].static_depth = nullptr;
+  });
+  const VisibilityResult b =
+      scene.pass(with_zeros, [](auto& depths, auto&) { depths[kWithout].setTo(0.0f); });
   EXPECT_EQ(a.elements, b.elements);
   EXPECT_EQ(a.seen_through, b.seen_through);
   EXPECT_EQ(a.mask_voted, b.mask_voted);
