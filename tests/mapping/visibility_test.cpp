@@ -247,12 +247,13 @@ TEST(Visibility, TwoThreadsGiveTheSameResultEveryTime) {
   }
 }
 
+constexpr int kWithout = 5;  // AKeyframeWithoutStaticDepthOnlyVotes: the keyframe without depth
+
 // A keyframe without static depth (nullptr) gives no points but still votes with its view: the
 // same edits and counts as a keyframe whose static depth is all zero. 9 keyframes: the pass keys
 // them four at a time, so the batches are 4, 4 and 1.
 TEST(Visibility, AKeyframeWithoutStaticDepthOnlyVotes) {
   constexpr int kKeyframes = 9;
-  static constexpr int kWithout = 5;
   const BoxInFirstTwo scene(kKeyframes);
   std::vector<cv::Mat> with_null, with_zeros;
   const VisibilityResult a = scene.pass(with_null, [](auto& depths, auto& kfs) {
