@@ -33,7 +33,11 @@ CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=
 
 run_asan() {
   local dir=${ASAN_BUILD_DIR:-build-asan}
-  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_SANITIZE=ON >/dev/null
+  # DYNAMAP_FUZZ=ON: the same libraries as scripts/fuzz.sh builds (with libFuzzer's coverage
+  # instrumentation), so that the fuzzers and this suite share one build (test.sh: one clang
+  # ASan build instead of two); the fuzz tests are left out of this run (-LE fuzz).
+  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=ON \
+    >/dev/null
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_io_tests dynamap_eval_tests dynamap_tracking_tests dynamap_dynamic_tests \
     dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests
