@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include <opencv2/imgproc.hpp>
+
 namespace dynamap {
 namespace {
 constexpr double kMaxMoveM = 0.3;    ///< 9 m/s at 30 frames/s over one frame
@@ -52,6 +54,27 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       }
     }
   }
+  return out;
+}
+
+cv::Mat marginNotBehind(const cv::Mat& mask, const cv::Mat& depth_m, int radius_px,
+                        double behind_m) {
+  if (behind_m <= 0.0 || radius_px <= 0 || mask.empty() || depth_m.size() != mask.size()) {
+    return mask;
+  }
+  // The mask's core (what the margin was grown from) and the farthest depth of the core within
+  // the margin of each pixel; pixels with no core that near (a sliver a later frame's mask
+  // added) stay as they are.
+  const int k = 2 * radius_px + 1;
+  const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k});
+  cv::Mat core;
+  cv::erode(mask, core, disc);
+  cv::Mat core_depth = cv::Mat::zeros(depth_m.size(), CV_32FC1);
+  depth_m.copyTo(core_depth, core);
+  cv::Mat farthest;
+  cv::dilate(core_depth, farthest, disc);
+  cv::Mat out = mask.clone();
+  out.setTo(0, (depth_m > farthest + behind_m) & (farthest > 0.f));
   return out;
 }
 

@@ -13,6 +13,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.depth_edge_threshold_m", &s.depth_edge_threshold_m, 0.0, 100.0);
   schema.addInt("mapping.stride", &s.stride, 1, 64);
   schema.addInt("mapping.mask_lookahead_frames", &c.mask_lookahead_frames, 0, 30);
+  schema.addDouble("mapping.mask_margin_behind_m", &c.mask_margin_behind_m, 0.0, 10.0);
   schema.addBool("mapping.free_space_check", &s.free_space.enabled);
   schema.addInt("mapping.free_space_neighbours", &s.free_space.neighbours, 1, 20);
   schema.addDouble("mapping.free_space_margin_m", &s.free_space.margin_m, 0.0, 10.0);
@@ -32,6 +33,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addDouble("mapping.visibility_mask_span_view_ratio", &vis.mask_span_view_ratio, 0.0, 1e6);
   schema.addInt("mapping.visibility_mask_near_px", &vis.mask_near_px, 0, 1000);
   schema.addDouble("mapping.visibility_mask_near_depth_m", &vis.mask_near_depth_m, 0.0, 100.0);
+  schema.addInt("mapping.visibility_mask_grow_px", &vis.mask_grow_px, 0, 100);
   schema.addBool("mapping.deferred_integration", &s.deferred_integration);
 }
 

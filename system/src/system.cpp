@@ -29,6 +29,8 @@ struct System::Impl {
   bool finished = false;
   // Mask look-ahead: the last keyframe waits for the masks of the next frames.
   int lookahead_frames = 0;
+  int margin_px = 0;  // dynamic.mask_dilation_px
+  double margin_behind_m = 0.0;
   std::shared_ptr<KeyframePacket> pending;
   int pending_seen = 0;
   std::vector<KeyframePacketPtr> last_mapped;  // released by finish()
@@ -72,6 +74,11 @@ void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& track
 
 void System::Impl::releasePending(std::vector<KeyframePacketPtr>& mapped) {
   if (!pending) return;
+  if (margin_behind_m > 0.0 && !pending->dynamic_mask.empty()) {
+    ScopedStageTimer timer(timings, "mask_margin");
+    pending->dynamic_mask =
+        marginNotBehind(pending->dynamic_mask, pending->depth_m, margin_px, margin_behind_m);
+  }
   KeyframePacketPtr kf = std::move(pending);
   pending.reset();
   mapped.push_back(kf);
@@ -105,7 +112,12 @@ System::System(const AppConfig& config, SystemOptions options) : impl_(std::make
                                       s.options.mapping_queue_capacity, s.timings);
   s.motion_filter = std::move(s.options.motion_filter);
   if (s.options.given_poses) return;
-  if (!s.motion_filter) s.motion_filter = makeMotionFilter(config.dynamic, s.camera, s.timings);
+  if (!s.motion_filter) {
+    s.motion_filter = makeMotionFilter(config.dynamic, s.camera, s.timings);
+    // The margin trimmed is the one this motion filter grows; given masks have none.
+    s.margin_px = config.dynamic.mask_dilation_px;
+    s.margin_behind_m = config.mapping.mask_margin_behind_m;
+  }
   s.tracker = std::make_unique<Tracker>(s.camera, config.tracking, s.timings);
   s.tracker->setMotionFilter(s.motion_filter.get());
 }

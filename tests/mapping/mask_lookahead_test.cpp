@@ -69,5 +69,32 @@ TEST(MaskLookahead, MarksTheMoverALaterMaskCoversAndNotWhatMovedInFrontLater) {
   EXPECT_EQ(cv::countNonZero(maskSeenLater(camera, no_depth, T_W_K, depth_l, T_W_L, mask_l)), 0);
 }
 
+TEST(MarginNotBehind, TheMarginLeavesTheWallBehindButKeepsTheOutlineHolesFloorAndSlivers) {
+  // A person 2 m away (100 x 200 px) before a wall at 4 m, masked as the motion filter does: his
+  // pixels 2 px short on every side, grown by 3 px. A hole without depth touches his right side,
+  // the floor at 2.05 m his feet; a later frame's sliver (4 px wide) lies on the wall far off.
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(4.f));
+  depth(cv::Rect(200, 100, 100, 200)).setTo(2.f);
+  depth(cv::Rect(300, 150, 20, 20)).setTo(0.f);
+  depth(cv::Rect(150, 300, 200, 30)).setTo(2.05f);
+  cv::Mat mask = cv::Mat::zeros(depth.size(), CV_8UC1);
+  mask(cv::Rect(202, 102, 96, 196)).setTo(255);
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  mask(cv::Rect(500, 50, 4, 60)).setTo(255);
+  const cv::Mat out = marginNotBehind(mask, depth, 3, 0.1);
+  EXPECT_EQ(cv::countNonZero(out & ~mask), 0);  // never more than the mask
+  ASSERT_EQ(mask.at<uchar>(240, 199), 255);
+  EXPECT_EQ(out.at<uchar>(240, 199), 0);    // the margin on the wall
+  EXPECT_EQ(out.at<uchar>(240, 200), 255);  // his outline, which the core missed
+  EXPECT_EQ(out.at<uchar>(160, 300), 255);  // the hole beside him
+  EXPECT_EQ(out.at<uchar>(300, 250), 255);  // the floor at his feet
+  EXPECT_EQ(out.at<uchar>(80, 501), 255);   // the sliver: no core near it
+  // Of the wall, only the sliver stays: the margin on it (1 px wide, 472 px) is gone.
+  EXPECT_EQ(cv::countNonZero((depth > 3.f) & out), 4 * 60);
+  EXPECT_GT(cv::countNonZero((depth > 3.f) & mask), 4 * 60 + 400);
+  // behind_m = 0: the mask as it is.
+  EXPECT_EQ(cv::countNonZero(marginNotBehind(mask, depth, 3, 0.0) != mask), 0);
+}
+
 }  // namespace
 }  // namespace dynamap

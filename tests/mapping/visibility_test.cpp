@@ -166,6 +166,26 @@ TEST(Visibility, MaskVotesRemoveWhatMostKeyframesMasked) {
   EXPECT_GT(standing, 500u);
 }
 
+// A view's mask blocks (1/4 resolution: at least half the block masked) take the mask grown by
+// mask_grow_px: a mask whose edge lies 1 px into a block column (its margin taken off the
+// background) marks the column when grown by 3, and not when taken as it is.
+TEST(Visibility, ViewMasksGrowByMaskGrowPx) {
+  const cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(2.f));
+  cv::Mat mask = cv::Mat::zeros(depth.size(), CV_8UC1);
+  mask(cv::Rect(0, 0, 317, 480)).setTo(255);  // block column 79 (x 316-319): 1 px masked
+  VisibilityOptions options;
+  options.mask_grow_px = 0;
+  const VisibilityView plain = makeVisibilityView(depth, mask, options);
+  options.mask_grow_px = 3;
+  const VisibilityView grown = makeVisibilityView(depth, mask, options);
+  ASSERT_EQ(plain.downsample, 4);
+  EXPECT_EQ(plain.moving.at<uchar>(60, 78), 255);
+  EXPECT_EQ(plain.moving.at<uchar>(60, 79), 0);
+  EXPECT_EQ(grown.moving.at<uchar>(60, 79), 255);  // grown to x 319
+  EXPECT_EQ(grown.moving.at<uchar>(60, 80), 0);
+  EXPECT_EQ(cv::countNonZero(grown.moving) - cv::countNonZero(plain.moving), 120);
+}
+
 // removeSeenThrough() alone: a keyframe that saw through a surface removes it, one that saw it
 // (or saw something nearer along the ray) does not; the depth image is edited in place.
 TEST(Visibility, RemovesOnlyWhatAnotherKeyframeSawThrough) {

@@ -20,6 +20,9 @@ struct MappingConfig {
   /// is masked in it too (maskSeenLater): a person the detector finds a moment later was there
   /// already. 0 = a keyframe goes to the mapper at once.
   int mask_lookahead_frames = 2;
+  /// A keyframe's mask, once complete, keeps its margin (dynamic.mask_dilation_px) off pixels
+  /// more than this (m) behind the masked depth next to them (marginNotBehind()). 0 = as it is.
+  double mask_margin_behind_m = 0.1;
 };
 
 }  // namespace dynamap

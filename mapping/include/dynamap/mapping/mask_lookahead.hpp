@@ -21,4 +21,12 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
                       const Eigen::Isometry3d& T_W_L, const cv::Mat& later_mask,
                       double occluder_margin_m = 0.15);
 
+/// A keyframe's final mask without the part of its margin (`radius_px`, the motion filter's
+/// dilation) that lies more than `behind_m` behind the depth of the mask's core (the mask eroded
+/// by the radius) next to it: the background around a person's outline. Pixels without depth,
+/// and those with no core within the radius (a sliver a later frame's mask added), are kept.
+/// The map keeps its own margin (StaticPointsOptions::mask_dilation_px). behind_m <= 0: `mask`.
+cv::Mat marginNotBehind(const cv::Mat& mask, const cv::Mat& depth_m, int radius_px,
+                        double behind_m);
+
 }  // namespace dynamap

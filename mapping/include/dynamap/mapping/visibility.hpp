@@ -36,6 +36,10 @@ struct VisibilityOptions {
   /// voxels around them.
   int mask_near_px = 24;
   double mask_near_depth_m = 0.3;
+  /// The dynamic mask is grown by this radius (px) before its blocks are judged: the margin
+  /// that a keyframe's mask keeps off the background (mapping.mask_margin_behind_m) still
+  /// counts for the votes of what lies at a mover's outline.
+  int mask_grow_px = 3;
 };
 
 /// What one keyframe saw, kept for the whole run: the nearest surface of its full depth image
@@ -89,8 +93,9 @@ struct VisibilityResult {
 /// point pairs. Runs on two threads (keyframes keyed four at a time, whichever thread is free,
 /// and added in their order; the element table in two parts by the parity of the voxel key,
 /// each filled, projected and judged by one thread; removal split by keyframe, walking each
-/// keyframe's runs of one voxel as keyed): the result does not depend on the threads. per_keyframe_ms is CPU time. Thread-safe for distinct keyframes (modifies only their
-/// depth images).
+/// keyframe's runs of one voxel as keyed): the result does not depend on the threads.
+/// per_keyframe_ms is CPU time. Thread-safe for distinct keyframes (modifies only their depth
+/// images).
 VisibilityResult removeSeenThrough(const PinholeCamera& camera,
                                    std::vector<VisibilityKeyframe>& keyframes,
                                    const VisibilityOptions& options);
