@@ -9,16 +9,6 @@
 namespace dynamap {
 namespace {
 
-cv::Mat dilatedMask(const cv::Mat& dynamic_mask, int radius_px) {
-  cv::Mat moving = dynamic_mask == 255;
-  if (radius_px <= 0) return moving;
-  const cv::Mat kernel =
-      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius_px + 1, 2 * radius_px + 1));
-  cv::Mat dilated;
-  cv::dilate(moving, dilated, kernel);
-  return dilated;
-}
-
 // True when a valid 4-neighbour's depth differs by more than `threshold` (a mixed pixel).
 bool isDepthEdge(const cv::Mat& depth, int r, int c, float z, float threshold) {
   const int dr[4] = {-1, 1, 0, 0};
@@ -58,6 +48,16 @@ void backProjectDepth(const PinholeCamera& camera, const cv::Mat& bgr, const cv:
       }
     }
   }
+}
+
+cv::Mat dilatedMask(const cv::Mat& dynamic_mask, int radius_px) {
+  cv::Mat moving = dynamic_mask == 255;
+  if (radius_px <= 0) return moving;
+  const cv::Mat kernel =
+      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius_px + 1, 2 * radius_px + 1));
+  cv::Mat dilated;
+  cv::dilate(moving, dilated, kernel);
+  return dilated;
 }
 
 cv::Mat staticDepth(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,

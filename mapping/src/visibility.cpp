@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "dynamap/mapping/radix_sort.hpp"
+#include "dynamap/mapping/static_points.hpp"
 #include "in_two.hpp"
 #include "visibility_table.hpp"
 
@@ -227,11 +228,7 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic
   block.setTo(0.0f, block >= kNoReading);
   view.near_m = block;
   if (dynamic_mask.size() == depth_m.size() && dynamic_mask.type() == CV_8UC1) {
-    cv::Mat moving = dynamic_mask == 255;
-    if (options.mask_grow_px > 0) {
-      const int k = 2 * options.mask_grow_px + 1;
-      cv::dilate(moving, moving, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
-    }
+    const cv::Mat moving = dilatedMask(dynamic_mask, options.mask_grow_px);
     cv::Mat share;  // block mean of the moving pixels
     cv::resize(moving, share, block.size(), 0, 0, cv::INTER_AREA);
     view.moving = share >= 128;

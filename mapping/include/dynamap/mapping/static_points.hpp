@@ -40,6 +40,9 @@ struct StaticPoints {
   std::vector<std::array<std::uint8_t, 3>> colors;  ///< RGB, one per point
 };
 
+/// The moving pixels of `dynamic_mask` (255) grown by a disc of `radius_px` (0: as they are).
+cv::Mat dilatedMask(const cv::Mat& dynamic_mask, int radius_px);
+
 /// depth_m: CV_32FC1 metres (0 = none); bgr: CV_8UC3 or empty (grey points);
 /// dynamic_mask: CV_8UC1 with 255 = moving (any other value static), or empty.
 /// Drops masked pixels (after dilation), depths outside [min, max], and depth edges (pixels whose
