@@ -200,13 +200,22 @@ TEST(RunCommand, RealtimeModeKeepsTrackingLagBounded) {
   const AppConfig effective = loadAppConfig((out / "config.yaml").string(), {});
   EXPECT_FALSE(effective.tracking.ba_lockstep);
   EXPECT_FALSE(effective.dynamic.detector_lockstep);
-  // Frames arrive at 30 Hz; stale frames are skipped so that tracking never falls far behind.
-  // The bound is 0.5 s; p95 of the lag is asserted against it.
+  // Frames arrive at 30 Hz; a frame more than 0.1 s late is skipped when a newer one waits, so
+  // no tracked frame (but the last) waits longer than 0.1 s or one frame period, on any machine.
   const std::string timings = test::readFile((out / "timings.json").string());
-  const auto lag = timings.find("\"realtime_lag\"");
-  ASSERT_NE(lag, std::string::npos) << timings;
-  const auto p95 = timings.find("\"p95_ms\":", lag);
-  EXPECT_LT(std::stod(timings.substr(p95 + 9)), 500.0) << timings;
+  const auto stageValue = [&timings](const std::string& stage, const std::string& key) {
+    const auto at = timings.find("\"" + stage + "\"");
+    EXPECT_NE(at, std::string::npos) << stage << " missing: " << timings;
+    if (at == std::string::npos) return 0.0;
+    const auto value = timings.find("\"" + key + "\":", at);
+    return std::stod(timings.substr(value + key.size() + 3));
+  };
+  EXPECT_LT(stageValue("realtime_wait", "max_ms"), 100.0 + 40.0) << timings;
+#ifndef DYNAMAP_INSTRUMENTED_BUILD
+  // The bound on the whole lag (wait + tracking) is 0.5 s: a speed bound, so it is
+  // asserted only where the code runs at full speed (sanitizers slow tracking 5-10 times).
+  EXPECT_LT(stageValue("realtime_lag", "p95_ms"), 500.0) << timings;
+#endif
 }
 
 }  // namespace

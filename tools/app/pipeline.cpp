@@ -142,6 +142,10 @@ void Pipeline::processFrames(RunResult& result) {
       }
     }
     const auto read_start = Clock::now();
+    if (options_.realtime && i + 1 < total) {  // the last frame is tracked however late
+      timings_.add("realtime_wait",
+                   std::chrono::duration<double, std::milli>(read_start - arrival(i)).count());
+    }
     FrameLoad load = frames.take(i);
     timings_.add("frame_read",
                  std::chrono::duration<double, std::milli>(Clock::now() - read_start).count());
