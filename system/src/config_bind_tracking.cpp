@@ -48,6 +48,8 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
+  schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);
+  schema.addInt("tracking.final_ba_max_iterations", &c.final_ba_max_iterations, 1, 500);
 
   schema.addInt("tracking.local_search_keyframes", &c.local_search_keyframes, 0, 1000);
   schema.addDouble("tracking.local_search_radius_px", &c.local_search_radius_px, 0.5, 200.0);

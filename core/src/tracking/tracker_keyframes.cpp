@@ -265,7 +265,11 @@ void Tracker::Impl::finish() {
   ba_.stop();
   if (config_.bundle_adjustment) {
     ba_.applyFinished();  // not lockstep: a solve that finished meanwhile
-    ba_.runOnce();
+    // Every keyframe (or the newest final_ba_window) at once: the local windows left the drift
+    // of the older ones in place.
+    const int window = config_.final_ba_window > 0 ? config_.final_ba_window
+                                                   : static_cast<int>(map_.keyframeCount());
+    ba_.runOnce(window, config_.final_ba_max_iterations);
   }
 }
 

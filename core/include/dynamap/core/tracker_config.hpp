@@ -78,6 +78,11 @@ struct TrackerConfig {
   int ba_window = 8;           ///< keyframes optimised together
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
   int ba_max_iterations = 10;
+  /// The last bundle adjustment, at finish(), optimises the newest this many keyframes together,
+  /// the oldest ba_fixed_keyframes of them held fixed (0 = every keyframe). The trajectory and
+  /// the map take its poses; the masks and every online decision were made before it.
+  int final_ba_window = 0;
+  int final_ba_max_iterations = 10;
 
   // --- search of the local map at keyframes ---
   /// Landmarks of the newest keyframes that are no longer tracked are matched by projection to

@@ -35,8 +35,10 @@ class LocalBundleAdjuster {
 
   void start();
   void requestRun();
-  void stop();     ///< finishes the running solve, joins; idempotent
-  void runOnce();  ///< one synchronous solve in the caller's thread
+  void stop();  ///< finishes the running solve, joins; idempotent
+  /// One synchronous solve in the caller's thread ("ba_final"), of the newest window_keyframes
+  /// (0 = ba_window) with at most max_iterations (0 = ba_max_iterations).
+  void runOnce(int window_keyframes = 0, int max_iterations = 0);
   std::vector<PoseUpdate> takeUpdates();
   /// ba_lockstep: waits for the requested/running solve and writes its result to the map.
   void applyFinished();
