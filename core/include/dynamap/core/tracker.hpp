@@ -81,7 +81,8 @@ class Tracker {
   void markBadFrame(double timestamp_s);
   /// Keyframe poses corrected by BA since the last call. Thread-safe.
   std::vector<PoseUpdate> takePoseUpdates();
-  /// Final BA over the window, stops the BA thread. Idempotent.
+  /// Stops the BA thread, then one BA over every keyframe (TrackerConfig::final_ba_window).
+  /// Idempotent.
   void finish();
 
   /// One entry per frame given to track() (not bad frames): the pose relative to its reference
