@@ -11,6 +11,7 @@ namespace dynamap {
 namespace {
 
 constexpr double kDepthUnitsPerM = 5000.0;
+constexpr int kHeldStridePx = 2;  ///< confirmed-static points: one per 2 x 2 pixels
 
 bool movedBeyond(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double trans_m,
                  double rot_rad) {
@@ -165,6 +166,15 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   }
   if (options_.visibility.enabled)
     rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
+  if (options_.held_revision_voxel_m > 0.0) {
+    rec.held.confirmed_C = confirmedPoints(camera_, kf.depth_m, kf.confirmed_mask, kHeldStridePx);
+    if (!kf.held_mask.empty() && !kf.dynamic_mask.empty()) {
+      rec.held.held = kf.held_mask & kf.dynamic_mask;
+      kf.depth_m.convertTo(rec.held_depth_u16, CV_16UC1, kDepthUnitsPerM);
+      rec.dynamic_mask = kf.dynamic_mask;  // shared, immutable packet data
+      rec.extra_mask = extra_mask;
+    }
+  }
   if (records_.emplace(kf.id, std::move(rec)).second) order_.push_back(kf.id);
   const auto early = early_updates_.find(kf.id);
   if (early != early_updates_.end()) {
@@ -199,6 +209,47 @@ bool MappingWorker::removeSeenThroughLocked() {
     timings_->add("mapping_visibility_zero", visibility_.zero_ms);
   }
   return visibility_.removed_pixels > 0;
+}
+
+bool MappingWorker::reviseHeldLocked() {
+  if (options_.held_revision_voxel_m <= 0.0 || order_.empty()) return false;
+  ScopedStageTimer timer(timings_, "mapping_held_revision");
+  std::vector<HeldKeyframe> keyframes;
+  keyframes.reserve(order_.size());
+  for (const std::uint64_t id : order_) {
+    KeyframeRecord& rec = records_.at(id);
+    rec.held.T_W_C = rec.T_current;
+    if (!rec.held_depth_u16.empty())
+      rec.held_depth_u16.convertTo(rec.held.depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
+    keyframes.push_back(std::move(rec.held));
+  }
+  const std::vector<cv::Mat> hits = heldConfirmedElsewhere(
+      camera_, keyframes, options_.held_revision_voxel_m, options_.held_revision_min_keyframes);
+  bool any = false;
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    KeyframeRecord& rec = records_.at(order_[i]);
+    if (!hits[i].empty() && !rec.depth_u16.empty()) {
+      cv::Mat revised = rec.dynamic_mask.clone();
+      revised.setTo(0, hits[i]);
+      const cv::Mat map_mask = rec.extra_mask.empty() ? revised : cv::max(revised, rec.extra_mask);
+      staticDepth(keyframes[i].depth_m, map_mask, options_)
+          .convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
+      if (options_.visibility.enabled)
+        rec.view = makeVisibilityView(keyframes[i].depth_m, revised, options_.visibility);
+      revised_masks_[order_[i]] = revised;
+      any = true;
+    }
+    rec.held = HeldKeyframe();  // done: its depth and masks are released
+    rec.held_depth_u16.release();
+    rec.dynamic_mask.release();
+    rec.extra_mask.release();
+  }
+  return any;
+}
+
+std::unordered_map<std::uint64_t, cv::Mat> MappingWorker::revisedMasks() const {
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  return revised_masks_;
 }
 
 void MappingWorker::rebuildIfNeeded(bool force) {
@@ -257,8 +308,9 @@ void MappingWorker::finish() {
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   for (const auto& u : late) applyUpdateLocked(u);
+  const bool revised = reviseHeldLocked();
   const bool removed = removeSeenThroughLocked();
-  rebuildIfNeeded(removed || deferred());
+  rebuildIfNeeded(removed || revised || deferred());
 }
 
 void MappingWorker::exportMap(const std::string& dir) {

@@ -68,6 +68,14 @@ void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& track
     if (cv::countNonZero(later) > 0) {  // a new Mat: the tracker's keyframe keeps its own mask
       pending->dynamic_mask = pending->dynamic_mask.empty() ? later : pending->dynamic_mask | later;
     }
+    // What a later frame saw moving for a reason of its own is no longer only held back there.
+    if (!pending->held_mask.empty() && !moving.empty()) {
+      cv::Mat moved = moving;
+      if (!tracked.held_mask.empty()) moved = moving & ~tracked.held_mask;
+      const cv::Mat later_moved = maskSeenLater(camera, pending->depth_m, pending->T_W_C,
+                                                frame.depth_m, tracked.T_W_C, moved);
+      if (cv::countNonZero(later_moved) > 0) pending->held_mask = pending->held_mask & ~later_moved;
+    }
   }
   if (++pending_seen >= lookahead_frames) releasePending(mapped);
 }
@@ -251,6 +259,11 @@ void System::finish() {
     s.mapper->applyPoseUpdates(final_poses);
   }
   s.mapper->finish();
+}
+
+std::unordered_map<std::uint64_t, cv::Mat> System::revisedMasks() const {
+  if (!impl_->finished) return {};
+  return impl_->mapper->revisedMasks();
 }
 
 std::vector<KeyframePacketPtr> System::takeLastMapped() {

@@ -173,6 +173,32 @@ TEST(FusionOverTime, OnlyProvenStaticPointsCarveAMovingRegion) {
   EXPECT_LT(maskedShare(rb.mask, standing), 0.5);
 }
 
+// What the map may judge in hindsight: a person masked only for lack of quiet frames is held
+// back; a person masked for flagged points is not; once kept, the person is confirmed.
+TEST(FusionOverTime, APersonMaskedOnlyForLackOfQuietFramesIsHeldBackNotOneThatMoved) {
+  Scene s;
+  const cv::Rect person(200, 150, 80, 250), walker(420, 150, 80, 250);
+  s.place(person, 2.f);
+  s.place(walker, 2.5f);
+  DynamicConfig c;
+  c.static_confirm_frames = 3;
+  RegionFusion fusion(c, ClassTable(c));
+  for (int i = 0; i < 2; ++i) {
+    const FusionResult r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.flagged(walker),
+                                       {box(person), box(walker)});
+    EXPECT_GT(maskedShare(r.mask, person), 0.99) << "frame " << i;
+    EXPECT_GT(maskedShare(r.held, person), 0.99) << "frame " << i;
+    EXPECT_GT(maskedShare(r.mask, walker), 0.99) << "frame " << i;
+    EXPECT_LT(maskedShare(r.held, walker), 0.01) << "frame " << i;
+    EXPECT_EQ(cv::countNonZero(r.confirmed), 0);
+  }
+  const FusionResult r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.flagged(walker),
+                                     {box(person), box(walker)});
+  EXPECT_LT(maskedShare(r.mask, person), 0.01);
+  EXPECT_GT(maskedShare(r.confirmed, person), 0.99);
+  EXPECT_EQ(cv::countNonZero(r.held), 0);
+}
+
 }  // namespace
 }  // namespace dynamap
 

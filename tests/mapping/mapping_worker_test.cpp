@@ -219,5 +219,43 @@ TEST(MappingWorker, FusingBackendsGetTheNarrowerMaskMargin) {
   EXPECT_EQ(pointsFor(true, 5), kept_points);
 }
 
+// A box held back in keyframe 0 (masked only for lack of proof that it stands still) that
+// keyframes 1 and 2 confirmed static at the same place reaches the map after all; its revised
+// mask is reported. With the revision off (voxel 0) keyframe 0 keeps its mask.
+TEST(MappingWorker, HeldPixelsConfirmedByOtherKeyframesAreMappedAndTheirMaskRevised) {
+  const auto run = [](double voxel_m, std::unordered_map<std::uint64_t, cv::Mat>* revised) {
+    FakeLog log;
+    log.released = true;
+    StaticPointsOptions options = countingOptions();
+    options.held_revision_voxel_m = voxel_m;
+    MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
+                         SyntheticScene::camera(), options, 4, nullptr);
+    for (std::uint64_t id = 0; id < 3; ++id) {
+      auto kf = std::make_shared<KeyframePacket>(*packet(0));  // one view, three times
+      kf->id = id;
+      if (id == 0) {
+        kf->held_mask = kf->dynamic_mask.clone();
+      } else {
+        kf->confirmed_mask = kf->dynamic_mask.clone();
+        kf->dynamic_mask = cv::Mat();
+      }
+      worker.push(kf);
+    }
+    worker.finish();
+    *revised = worker.revisedMasks();
+    EXPECT_EQ(log.integrated.size(), 3u);
+    return log.points.empty() ? std::size_t{0} : log.points.front();
+  };
+  const int masked = cv::countNonZero(packet(0)->dynamic_mask);
+  ASSERT_GT(masked, 100) << "the scene lost its mover";
+  std::unordered_map<std::uint64_t, cv::Mat> revised_on, revised_off;
+  const std::size_t on = run(0.03, &revised_on), off = run(0.0, &revised_off);
+  EXPECT_TRUE(revised_off.empty());
+  ASSERT_EQ(revised_on.count(0), 1u);
+  EXPECT_EQ(revised_on.size(), 1u);
+  EXPECT_LT(cv::countNonZero(revised_on.at(0)), masked / 10);
+  EXPECT_GT(on, off + static_cast<std::size_t>(masked) / 2);
+}
+
 }  // namespace
 }  // namespace dynamap::test

@@ -189,37 +189,53 @@ void Pipeline::processFrame(std::size_t index, const FrameLoad& load, RunResult&
   if (tracked.is_keyframe) {
     keyframe_entry_[tracked.keyframe->id] = index;
     if (!gt_masks_dir_.empty())
-      scoreKeyframeMask(entry, *tracked.keyframe, result.tracker_mask_scores);
+      if (const auto score = scoreKeyframeMask(entry, tracked.keyframe->dynamic_mask))
+        result.tracker_mask_scores.add(*score);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
-  mappedKeyframes(tracked.mapped, result);
+  mappedKeyframes(tracked.mapped);
 }
 
-void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped, RunResult& result) {
+void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped) {
   for (const KeyframePacketPtr& kf : mapped) {
     const auto it = keyframe_entry_.find(kf->id);
     if (it == keyframe_entry_.end()) continue;
     const SequenceEntry& entry = sequence_.entries()[it->second];
+    mapped_entry_[kf->id] = it->second;
     keyframe_entry_.erase(it);
-    if (!gt_masks_dir_.empty()) scoreKeyframeMask(entry, *kf, result.mask_scores);
-    if (options_.save_masks) writeKeyframeMask(entry, *kf);
+    cv::Mat mask = kf->dynamic_mask;
+    if (mask.empty()) mask = cv::Mat::zeros(kf->bgr.size(), CV_8UC1);
+    if (const auto score = scoreKeyframeMask(entry, mask)) mapped_scores_[kf->id] = *score;
+    if (options_.save_masks) writeKeyframeMask(entry, mask, kf->bgr.size());
   }
 }
 
-void Pipeline::scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
-                                 MaskScoreSummary& scores) const {
-  const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
-  const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (gt.empty() || gt.size() != keyframe.bgr.size()) return;  // no usable truth
-  scores.add(scoreMask(keyframe.dynamic_mask, gt));
+void Pipeline::revisedKeyframeMasks(RunResult& result) {
+  for (const auto& [id, mask] : stages_->system->revisedMasks()) {
+    const auto it = mapped_entry_.find(id);
+    if (it == mapped_entry_.end()) continue;
+    const SequenceEntry& entry = sequence_.entries()[it->second];
+    if (const auto score = scoreKeyframeMask(entry, mask)) mapped_scores_[id] = *score;
+    if (options_.save_masks) writeKeyframeMask(entry, mask, mask.size());
+  }
+  for (const auto& kv : mapped_scores_) result.mask_scores.add(kv.second);
 }
 
-void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const {
+std::optional<MaskFrameScore> Pipeline::scoreKeyframeMask(const SequenceEntry& entry,
+                                                          const cv::Mat& mask) const {
+  if (gt_masks_dir_.empty() || mask.empty()) return std::nullopt;
+  const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
+  const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (gt.empty() || gt.size() != mask.size()) return std::nullopt;  // no usable truth
+  return scoreMask(mask, gt);
+}
+
+void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
+                                 const cv::Size& size) const {
   const fs::path dir = fs::path(options_.out_dir) / "masks";
   fs::create_directories(dir);
-  cv::Mat mask = keyframe.dynamic_mask;
-  if (mask.empty()) mask = cv::Mat::zeros(keyframe.bgr.size(), CV_8UC1);
-  writeImageAtomic((dir / (stampName(entry.rgb_path) + ".png")).string(), mask);
+  const cv::Mat out = mask.empty() ? cv::Mat(cv::Mat::zeros(size, CV_8UC1)) : mask;
+  writeImageAtomic((dir / (stampName(entry.rgb_path) + ".png")).string(), out);
 }
 
 void Pipeline::writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
@@ -249,7 +265,8 @@ void Pipeline::logObjects(const SequenceEntry& entry) {
 void Pipeline::finalize(RunResult& result) {
   System& system = *stages_->system;
   system.finish();
-  mappedKeyframes(system.takeLastMapped(), result);
+  mappedKeyframes(system.takeLastMapped());
+  revisedKeyframeMasks(result);
   const auto trajectory = system.trajectory();
   const auto statuses = system.frameStatuses();
   const bool given = stages_->given_poses != nullptr;

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -70,10 +72,14 @@ class Pipeline {
   void processFrame(std::size_t index, const FrameLoad& load, RunResult& result);
   void finalize(RunResult& result);
   /// Scores (and with --save-masks writes) the masks of keyframes handed to the mapper.
-  void mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped, RunResult& result);
-  void scoreKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe,
-                         MaskScoreSummary& scores) const;
-  void writeKeyframeMask(const SequenceEntry& entry, const KeyframePacket& keyframe) const;
+  void mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped);
+  /// After finish(): the masks the mapper revised replace the ones scored and written, and the
+  /// map's mask scores are summed.
+  void revisedKeyframeMasks(RunResult& result);
+  std::optional<MaskFrameScore> scoreKeyframeMask(const SequenceEntry& entry,
+                                                  const cv::Mat& mask) const;
+  void writeKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
+                         const cv::Size& size) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
                        const TrackOutput& tracked) const;
   /// --debug-images: every frame's object decisions, appended to OUT/debug/objects.tsv.
@@ -87,6 +93,8 @@ class Pipeline {
   std::string gt_masks_dir_;  ///< sequence_dir/mask when present
   bool object_log_started_ = false;
   std::unordered_map<std::uint64_t, std::size_t> keyframe_entry_;  ///< keyframe id -> entry
+  std::map<std::uint64_t, std::size_t> mapped_entry_;              ///< mapped keyframe id -> entry
+  std::map<std::uint64_t, MaskFrameScore> mapped_scores_;          ///< the map's masks vs the truth
 };
 
 }  // namespace dynamap

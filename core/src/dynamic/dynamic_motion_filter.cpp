@@ -308,6 +308,7 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   }
   fused.mask |= moved;
   if (!fused.unconfirmed.empty()) fused.unconfirmed.setTo(0, moved);
+  if (!fused.held.empty()) fused.held.setTo(0, moved);
 }
 
 cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
@@ -390,6 +391,9 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     out.match_held[i] = !epi.is_dynamic[i] && inMask(fused.unconfirmed, m.cur_px[i]) ? 1 : 0;
   }
   out.unconfirmed_mask = fused.unconfirmed;
+  if (!fused.held.empty() && cv::countNonZero(fused.held) > 0) out.held_mask = fused.held;
+  if (!fused.confirmed.empty() && cv::countNonZero(fused.confirmed) > 0)
+    out.confirmed_mask = fused.confirmed;
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
   prev_mask_ = fused.mask;
   pending_ = DepthView();

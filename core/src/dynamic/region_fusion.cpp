@@ -236,6 +236,7 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
       anchored ? anchor_still : (quiet && ev.background_fit) || (few_points && still);
   t.quiet_frames = d.moving_now ? 0 : before + (evidence_now ? 1 : 0);
   if (d.moving_now) t.has_anchor = false, t.anchors = d.anchor.fresh;
+  d.motion_now = flagged_now || anchor_moved || t.moving;
   if (classes_.isHighDynamic(d.detection.class_id)) {
     // Anchors off by more than the pose noise mask it in this frame (its count is kept).
     const int needed = config_.static_confirm_frames << std::min(t.slow_moves, kMaxSlowDoublings);
@@ -318,6 +319,7 @@ void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& regi
   }
   (d.moving ? result.mask : result.static_objects) |= region;
   if (d.moving) (d.unconfirmed ? result.unconfirmed : certain_) |= region;
+  if (d.moving) (d.motion_now || mode != FusionMode::kBoth ? evidenced_ : result.held) |= region;
   if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) confirmed_ |= region;
   result.objects.push_back(d);
 }
@@ -355,7 +357,9 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
   evidence_ = &evidence;
   confirmed_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   certain_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  evidenced_ = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.unconfirmed = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  result.held = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.mask = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   result.static_objects = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   cv::Mat claimed = cv::Mat::zeros(depth_m.size(), CV_8UC1);  // pixels of detected objects
@@ -419,12 +423,19 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     result.clusters = growClusters(depth_m, points, dyn, claimed, grown);
     result.mask |= grown;
     certain_ |= grown;
+    evidenced_ |= grown;
   }
   result.unconfirmed.setTo(0, certain_ | confirmed_);
+  result.confirmed = confirmed_;
   if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {
     const int k = 2 * config_.mask_dilation_px + 1;
-    cv::dilate(result.mask, result.mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+    const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k});
+    cv::dilate(result.mask, result.mask, disc);
+    // The held margin is the held object's, but not where a moving object's margin reaches.
+    cv::dilate(result.held, result.held, disc);
+    cv::dilate(evidenced_, evidenced_, disc);
   }
+  result.held.setTo(0, evidenced_ | confirmed_);
   return result;
 }
 

@@ -57,6 +57,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
       runMotionFilter(frame, gray, matches, has_prior ? &T_W_C_prior : nullptr);
   result.dynamic_mask = filtered.dynamic_mask;
   result.unconfirmed_mask = filtered.unconfirmed_mask;
+  result.held_mask = filtered.held_mask;
   MotionFilterOutput widened = filtered;
   widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
   result.dynamic_matches = dropDynamic(matches, widened);
@@ -69,8 +70,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     tracks_.clear();
     // The first frame starts the map at the origin; a restart after a long loss starts a new
     // part of the map where the camera was last seen.
-    result.keyframe =
-        createKeyframe(frame, gray, T_W_last_, filtered.dynamic_mask, initialMask(gray, widened));
+    result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered, initialMask(gray, widened));
     if (result.keyframe) {
       initialized_ = true;
       lost_streak_ = 0;
@@ -93,8 +93,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     result.T_W_C = T_W_C;
     // Held-back objects (a teddy taken for a person) are no movers: they do not count.
     if (needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
-      result.keyframe =
-          createKeyframe(frame, gray, T_W_C, filtered.dynamic_mask, widened.dynamic_mask);
+      result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
     }
   }
   if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);

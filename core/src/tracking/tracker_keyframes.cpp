@@ -165,7 +165,7 @@ std::vector<int> Tracker::Impl::searchLocalMap(const OrbFeatures& features,
 
 KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                                 const Eigen::Isometry3d& T_W_C,
-                                                const cv::Mat& dynamic_mask,
+                                                const MotionFilterOutput& filtered,
                                                 const cv::Mat& track_mask) {
   const OrbFeatures features = extractOrb(gray, track_mask);
   const double max_landmark_m = std::min(config_.depth_max_m, config_.landmark_depth_max_m);
@@ -223,7 +223,9 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
   packet->T_W_C = T_W_C;
   packet->bgr = frame.bgr.clone();
   packet->depth_m = frame.depth_m.clone();
-  packet->dynamic_mask = dynamic_mask.clone();
+  packet->dynamic_mask = filtered.dynamic_mask.clone();
+  if (!packet->dynamic_mask.empty()) packet->held_mask = filtered.held_mask.clone();
+  packet->confirmed_mask = filtered.confirmed_mask.clone();
   return packet;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -115,6 +117,10 @@ class System {
   /// The keyframe finish() handed to the mapper (the one still waiting for later masks), once;
   /// empty if none. Thread-safe as finish().
   std::vector<KeyframePacketPtr> takeLastMapped();
+  /// After finish(): keyframe id -> the mask the map used, for the keyframes whose masks
+  /// finish() revised (held-back people another keyframe confirmed static; the packets keep
+  /// the masks they had when mapped). Empty before finish().
+  std::unordered_map<std::uint64_t, cv::Mat> revisedMasks() const;
   /// finish(), then writes the backend's map files into `dir` (created if needed).
   void exportMap(const std::string& dir);
 

@@ -36,6 +36,11 @@ struct KeyframePacket {
   cv::Mat bgr;                                              ///< CV_8UC3
   cv::Mat depth_m;                                          ///< CV_32FC1, 0 = no reading
   cv::Mat dynamic_mask;  ///< CV_8UC1, 255 = moving; empty = nothing dynamic
+  /// CV_8UC1, may be empty (MotionFilterOutput): the part of dynamic_mask held back only for
+  /// lack of evidence that it stands still, and the pixels of objects confirmed static. Mapping
+  /// unmasks held pixels where another keyframe confirmed an object static.
+  cv::Mat held_mask;
+  cv::Mat confirmed_mask;
 };
 using KeyframePacketPtr = std::shared_ptr<const KeyframePacket>;
 

@@ -48,6 +48,11 @@ struct MotionFilterOutput {
   /// when the rest of the image cannot hold a pose.
   std::vector<std::uint8_t> match_held;
   cv::Mat unconfirmed_mask;  ///< CV_8UC1 (may be empty): the pixels behind match_held
+  /// CV_8UC1 (may be empty): the part of dynamic_mask whose objects showed no motion of their own
+  /// in this frame (masked only until they prove still), and the pixels of objects confirmed
+  /// static over time. They reach KeyframePacket for mapping to judge in hindsight.
+  cv::Mat held_mask;
+  cv::Mat confirmed_mask;
 };
 
 /// Hook between feature matching and pose estimation. The tracker drops dynamic matches and

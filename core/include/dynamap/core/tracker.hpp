@@ -29,6 +29,9 @@ struct TrackingResult {
   /// Of dynamic_mask, the pixels masked only for lack of evidence that they stand still
   /// (MotionFilterOutput::unconfirmed_mask); may be empty.
   cv::Mat unconfirmed_mask;
+  /// The part of dynamic_mask held back only for lack of evidence that it stands still
+  /// (MotionFilterOutput::held_mask); may be empty.
+  cv::Mat held_mask;
 };
 
 /// Counters over all frames. frames = tracked + relocalized + lost + bad_frames.

@@ -13,6 +13,7 @@
 
 #include "dynamap/core/frame.hpp"
 #include "dynamap/core/timing.hpp"
+#include "dynamap/mapping/held_revision.hpp"
 #include "dynamap/mapping/map_backend.hpp"
 #include "dynamap/mapping/static_points.hpp"
 
@@ -59,6 +60,9 @@ class MappingWorker {
   std::size_t reintegratedKeyframes() const;
   /// The visibility pass of finish() (all zero before finish() or when it is disabled).
   VisibilityResult visibilityResult() const;
+  /// After finish(): the masks that the held-back revision changed (keyframe id -> the mask the
+  /// map used), see StaticPointsOptions::held_revision_voxel_m.
+  std::unordered_map<std::uint64_t, cv::Mat> revisedMasks() const;
 
  private:
   struct KeyframeRecord {
@@ -68,6 +72,12 @@ class MappingWorker {
     cv::Mat depth_u16;  ///< static depth, 1/5000 m
     cv::Mat bgr;
     VisibilityView view;  ///< options.visibility enabled only
+    /// options.held_revision_voxel_m > 0 and held pixels only, until finish(): the held and
+    /// confirmed pixels, the raw depth, the keyframe's mask and the free-space check's
+    HeldKeyframe held;
+    cv::Mat held_depth_u16;
+    cv::Mat dynamic_mask;
+    cv::Mat extra_mask;
   };
   struct WindowEntry {
     KeyframePacketPtr kf;
@@ -83,6 +93,8 @@ class MappingWorker {
   void rebuildIfNeeded(bool force);
   /// The visibility pass over all keyframes; true if it removed pixels.
   bool removeSeenThroughLocked();
+  /// Unmasks held-back pixels that another keyframe confirmed static; true if any.
+  bool reviseHeldLocked();
   void applyUpdateLocked(const PoseUpdate& update);
   /// Keyframes go to the backend only in finish() (see the class comment).
   bool deferred() const { return options_.visibility.enabled && options_.deferred_integration; }
@@ -109,6 +121,7 @@ class MappingWorker {
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
   VisibilityResult visibility_;
+  std::unordered_map<std::uint64_t, cv::Mat> revised_masks_;
   std::thread thread_;
 };
 

@@ -31,6 +31,11 @@ struct StaticPointsOptions {
   /// keyframes whenever it removes anything, so integrating them on arrival as well was work
   /// thrown away). false: each keyframe is also integrated when it arrives.
   bool deferred_integration = true;
+  /// MappingWorker::finish(): a keyframe's held-back pixels (KeyframePacket::held_mask) whose
+  /// world point lies within this voxel's reach of an object another keyframe confirmed static
+  /// are unmasked (heldConfirmedElsewhere()). 0 = off.
+  double held_revision_voxel_m = 0.03;
+  int held_revision_min_keyframes = 2;  ///< other keyframes that confirmed it (1-4)
 };
 
 /// The static part of one RGB-D keyframe. The only place where masks become map input.

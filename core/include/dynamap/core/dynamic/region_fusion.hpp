@@ -30,6 +30,9 @@ struct ObjectDecision {
   /// Masked only because it has not yet shown that it stands still: nothing of its own (flags,
   /// smoothed evidence, anchors, slow moves) says it moves.
   bool unconfirmed = false;
+  /// Motion evidence of its own in this frame: flags, anchors clearly off, or the smoothed
+  /// evidence still above its threshold. Masked without it, it is only held back.
+  bool motion_now = false;
   int quiet_frames = 0;  ///< observed frames with static evidence since it last moved
   double depth_m = 0.0;  ///< depth mode of the object (0 = no depth)
   bool has_position = false;
@@ -69,6 +72,12 @@ struct FusionResult {
   /// CV_8UC1, 255 = masked pixels of unconfirmed objects only (ObjectDecision::unconfirmed):
   /// what the tracker may fall back on when the rest of the image cannot hold a pose.
   cv::Mat unconfirmed;
+  /// CV_8UC1, 255 = masked pixels of objects without motion evidence of their own in this frame
+  /// (ObjectDecision::motion_now false): held back only until they prove still. Wider than
+  /// `unconfirmed` (slow moves and no-verdict anchors count here too).
+  cv::Mat held;
+  /// CV_8UC1, 255 = pixels of objects confirmed static over time (static_confirm_frames).
+  cv::Mat confirmed;
   std::vector<ObjectDecision> objects;
   int clusters = 0;      ///< dynamic-point clusters grown into regions outside objects
   int seen_through = 0;  ///< regions the dense check added (DynamicMotionFilter)
@@ -133,6 +142,7 @@ class RegionFusion {
   std::vector<ObjectTrack> tracks_;
   std::vector<std::uint8_t> proven_;  ///< this frame's FusionEvidence::proven_static
   cv::Mat confirmed_;                 ///< this frame's pixels of objects confirmed static over time
+  cv::Mat evidenced_;                 ///< this frame's pixels of objects masked for motion
   cv::Mat certain_;                   ///< this frame's moving pixels with evidence of their own
   const FusionEvidence* evidence_ = nullptr;  ///< during fuse()
 };

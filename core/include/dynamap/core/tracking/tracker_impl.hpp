@@ -77,10 +77,10 @@ class Tracker::Impl {
                     const cv::Mat& movers) const;
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
                                   const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
-  /// New landmarks come from outside `track_mask`; the packet carries `dynamic_mask`.
+  /// New landmarks come from outside `track_mask`; the packet carries the filter's masks.
   KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
-                                   const Eigen::Isometry3d& T_W_C, const cv::Mat& dynamic_mask,
-                                   const cv::Mat& track_mask);
+                                   const Eigen::Isometry3d& T_W_C,
+                                   const MotionFilterOutput& filtered, const cv::Mat& track_mask);
   OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
   void record(double timestamp_s, FrameStatus status, const Eigen::Isometry3d& T_W_C);
   void countStatus(FrameStatus status, bool keyframe);
