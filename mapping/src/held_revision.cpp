@@ -1,5 +1,6 @@
 #include "dynamap/mapping/held_revision.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -19,35 +20,46 @@ std::uint64_t cellKey(std::int64_t x, std::int64_t y, std::int64_t z) {
   return c(x) | (c(y) << kAxisBits) | (c(z) << (2 * kAxisBits));
 }
 
-/// The keyframes that confirmed a voxel (the first kMaxConfirmers of them).
-constexpr int kMaxConfirmers = 4;
-struct Confirmers {
-  std::array<int, kMaxConfirmers> by{};
-  int n = 0;
-  void add(int k) {
-    for (int i = 0; i < n; ++i) {
-      if (by[static_cast<std::size_t>(i)] == k) return;
-    }
-    if (n < kMaxConfirmers) by[static_cast<std::size_t>(n++)] = k;
+/// The keyframes that saw a voxel confirmed static, and those that saw it masked for motion
+/// (keyframes come in order, so each is counted once).
+constexpr int kListed = 8;
+struct VoxelVotes {
+  std::array<int, kListed> confirmers{};
+  int listed = 0;
+  int confirmed = 0;
+  int moved = 0;
+  int last_confirmer = -1;
+  int last_mover = -1;
+  void confirm(int k) {
+    if (k == last_confirmer) return;
+    last_confirmer = k;
+    ++confirmed;
+    if (listed < kListed) confirmers[static_cast<std::size_t>(listed++)] = k;
   }
-  int others(int k) const {
-    int count = 0;
-    for (int i = 0; i < n; ++i) count += by[static_cast<std::size_t>(i)] != k ? 1 : 0;
-    return count;
+  void move(int k) {
+    if (k == last_mover) return;
+    last_mover = k;
+    ++moved;
+  }
+  int confirmedByOthers(int k) const {
+    for (int i = 0; i < listed; ++i) {
+      if (confirmers[static_cast<std::size_t>(i)] == k) return confirmed - 1;
+    }
+    return confirmed;
   }
 };
 
 }  // namespace
 
-std::vector<Eigen::Vector3f> confirmedPoints(const PinholeCamera& camera, const cv::Mat& depth_m,
-                                             const cv::Mat& confirmed, int stride_px) {
+std::vector<Eigen::Vector3f> maskPoints(const PinholeCamera& camera, const cv::Mat& depth_m,
+                                        const cv::Mat& mask, int stride_px) {
   std::vector<Eigen::Vector3f> out;
-  if (confirmed.empty() || depth_m.empty() || confirmed.size() != depth_m.size()) return out;
+  if (mask.empty() || depth_m.empty() || mask.size() != depth_m.size()) return out;
   const int step = std::max(1, stride_px);
   for (int v = step / 2; v < depth_m.rows; v += step) {
     for (int u = step / 2; u < depth_m.cols; u += step) {
       const float z = depth_m.at<float>(v, u);
-      if (confirmed.at<std::uint8_t>(v, u) == 0 || !(z > 0.0f)) continue;
+      if (mask.at<std::uint8_t>(v, u) == 0 || !(z > 0.0f)) continue;
       out.push_back(camera.backProject(u, v, z).cast<float>());
     }
   }
@@ -63,15 +75,22 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
   const auto cell = [inv](const Eigen::Vector3d& p, std::int64_t c[3]) {
     for (int a = 0; a < 3; ++a) c[a] = static_cast<std::int64_t>(std::floor(p[a] * inv));
   };
-  std::unordered_map<std::uint64_t, Confirmers> confirmed;
+  std::unordered_map<std::uint64_t, VoxelVotes> votes;
+  bool any_confirmed = false;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     for (const Eigen::Vector3f& p_C : keyframes[k].confirmed_C) {
       std::int64_t c[3];
       cell(keyframes[k].T_W_C * p_C.cast<double>(), c);
-      confirmed[cellKey(c[0], c[1], c[2])].add(static_cast<int>(k));
+      votes[cellKey(c[0], c[1], c[2])].confirm(static_cast<int>(k));
+      any_confirmed = true;
+    }
+    for (const Eigen::Vector3f& p_C : keyframes[k].moved_C) {
+      std::int64_t c[3];
+      cell(keyframes[k].T_W_C * p_C.cast<double>(), c);
+      votes[cellKey(c[0], c[1], c[2])].move(static_cast<int>(k));
     }
   }
-  if (confirmed.empty()) return out;
+  if (!any_confirmed) return out;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const HeldKeyframe& kf = keyframes[k];
     if (kf.held.empty() || kf.depth_m.size() != kf.held.size()) continue;
@@ -84,16 +103,19 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
         if (h[u] == 0 || !(z[u] > 0.0f)) continue;
         std::int64_t c[3];
         cell(kf.T_W_C * camera.backProject(u, v, z[u]), c);
-        bool found = false;
-        for (int dz = -1; dz <= 1 && !found; ++dz) {
-          for (int dy = -1; dy <= 1 && !found; ++dy) {
-            for (int dx = -1; dx <= 1 && !found; ++dx) {
-              const auto it = confirmed.find(cellKey(c[0] + dx, c[1] + dy, c[2] + dz));
-              found =
-                  it != confirmed.end() && it->second.others(static_cast<int>(k)) >= min_keyframes;
+        // The most confirmations and the most motion around it (26 neighbours included).
+        int confirmed = 0, moved = 0;
+        for (int dz = -1; dz <= 1; ++dz) {
+          for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+              const auto it = votes.find(cellKey(c[0] + dx, c[1] + dy, c[2] + dz));
+              if (it == votes.end()) continue;
+              confirmed = std::max(confirmed, it->second.confirmedByOthers(static_cast<int>(k)));
+              moved = std::max(moved, it->second.moved);
             }
           }
         }
+        const bool found = confirmed >= min_keyframes && confirmed > moved;
         if (found) hit.at<std::uint8_t>(v, u) = 255, any = true;
       }
     }

@@ -167,7 +167,12 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   if (options_.visibility.enabled)
     rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
   if (options_.held_revision_voxel_m > 0.0) {
-    rec.held.confirmed_C = confirmedPoints(camera_, kf.depth_m, kf.confirmed_mask, kHeldStridePx);
+    rec.held.confirmed_C = maskPoints(camera_, kf.depth_m, kf.confirmed_mask, kHeldStridePx);
+    if (!kf.dynamic_mask.empty()) {
+      const cv::Mat moved =
+          kf.held_mask.empty() ? kf.dynamic_mask : kf.dynamic_mask & ~kf.held_mask;
+      rec.held.moved_C = maskPoints(camera_, kf.depth_m, moved, kHeldStridePx);
+    }
     if (!kf.held_mask.empty() && !kf.dynamic_mask.empty()) {
       rec.held.held = kf.held_mask & kf.dynamic_mask;
       kf.depth_m.convertTo(rec.held_depth_u16, CV_16UC1, kDepthUnitsPerM);
@@ -234,8 +239,9 @@ bool MappingWorker::reviseHeldLocked() {
       const cv::Mat map_mask = rec.extra_mask.empty() ? revised : cv::max(revised, rec.extra_mask);
       staticDepth(keyframes[i].depth_m, map_mask, options_)
           .convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
-      if (options_.visibility.enabled)
-        rec.view = makeVisibilityView(keyframes[i].depth_m, revised, options_.visibility);
+      // The visibility pass's mask votes keep reading the masks as they were: a person the
+      // revision wrongly unmasked (a swayer confirmed static now and then) is still voted out
+      // of the map by the views that masked him.
       revised_masks_[order_[i]] = revised;
       any = true;
     }

@@ -36,7 +36,7 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addInt("mapping.visibility_mask_grow_px", &vis.mask_grow_px, 0, 100);
   schema.addBool("mapping.deferred_integration", &s.deferred_integration);
   schema.addDouble("mapping.held_revision_voxel_m", &s.held_revision_voxel_m, 0.0, 1.0);
-  schema.addInt("mapping.held_revision_min_keyframes", &s.held_revision_min_keyframes, 1, 4);
+  schema.addInt("mapping.held_revision_min_keyframes", &s.held_revision_min_keyframes, 1, 1000);
 }
 
 }  // namespace dynamap

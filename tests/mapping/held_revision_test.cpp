@@ -34,11 +34,11 @@ HeldKeyframe view(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C, b
     }
   }
   if (held) kf.held = person;
-  if (confirmed) kf.confirmed_C = confirmedPoints(camera, kf.depth_m, person, 4);
+  if (confirmed) kf.confirmed_C = maskPoints(camera, kf.depth_m, person, 4);
   return kf;
 }
 
-TEST(HeldRevision, HeldPixelsThatOtherKeyframesConfirmedStaticAreFoundOthersNot) {
+TEST(HeldRevision, HeldPixelsOtherKeyframesConfirmedStaticMoreOftenThanMovingAreFound) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   std::vector<HeldKeyframe> kfs;
   kfs.push_back(view(camera, shiftedX(0.0), /*held=*/true, /*confirmed=*/false));
@@ -69,6 +69,23 @@ TEST(HeldRevision, HeldPixelsThatOtherKeyframesConfirmedStaticAreFoundOthersNot)
     for (auto& p : apart[k].confirmed_C) p.x() += 0.8f;
   }
   EXPECT_TRUE(heldConfirmedElsewhere(camera, apart, 0.03, 2)[0].empty());
+
+  // Confirmed static by two keyframes but seen moving there by three (a swayer, or walkers
+  // crossing the spot): no standing person.
+  std::vector<HeldKeyframe> swayer{view(camera, shiftedX(0.0), true, false),
+                                   view(camera, shiftedX(0.1), false, true),
+                                   view(camera, shiftedX(0.2), false, true)};
+  for (int k = 0; k < 3; ++k) {
+    HeldKeyframe moved = view(camera, shiftedX(0.05 * k), false, true);
+    moved.moved_C = moved.confirmed_C;
+    moved.confirmed_C.clear();
+    swayer.push_back(moved);
+  }
+  EXPECT_TRUE(heldConfirmedElsewhere(camera, swayer, 0.03, 2)[0].empty());
+  swayer.pop_back();  // two moving, two confirming: still not more confirmed than moved
+  EXPECT_TRUE(heldConfirmedElsewhere(camera, swayer, 0.03, 2)[0].empty());
+  swayer.pop_back();  // one moving, two confirming
+  EXPECT_FALSE(heldConfirmedElsewhere(camera, swayer, 0.03, 2)[0].empty());
 }
 
 }  // namespace

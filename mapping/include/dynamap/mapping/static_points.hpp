@@ -35,7 +35,7 @@ struct StaticPointsOptions {
   /// world point lies within this voxel's reach of an object another keyframe confirmed static
   /// are unmasked (heldConfirmedElsewhere()). 0 = off.
   double held_revision_voxel_m = 0.03;
-  int held_revision_min_keyframes = 2;  ///< other keyframes that confirmed it (1-4)
+  int held_revision_min_keyframes = 2;  ///< other keyframes that confirmed it there
 };
 
 /// The static part of one RGB-D keyframe. The only place where masks become map input.
