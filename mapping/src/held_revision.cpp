@@ -6,19 +6,10 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include "visibility_table.hpp"
+
 namespace dynamap {
 namespace {
-
-constexpr int kAxisBits = 21;
-constexpr std::int64_t kAxisOffset = std::int64_t{1} << (kAxisBits - 1);
-constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
-
-std::uint64_t cellKey(std::int64_t x, std::int64_t y, std::int64_t z) {
-  const auto c = [](std::int64_t v) {
-    return static_cast<std::uint64_t>(v + kAxisOffset) & kAxisMask;
-  };
-  return c(x) | (c(y) << kAxisBits) | (c(z) << (2 * kAxisBits));
-}
 
 /// The keyframes that saw a voxel confirmed static, and those that saw it masked for motion
 /// (keyframes come in order, so each is counted once).
@@ -71,23 +62,19 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
                                             double voxel_m, int min_keyframes) {
   std::vector<cv::Mat> out(keyframes.size());
   if (voxel_m <= 0.0) return out;
-  const double inv = 1.0 / voxel_m;
-  const auto cell = [inv](const Eigen::Vector3d& p, std::int64_t c[3]) {
-    for (int a = 0; a < 3; ++a) c[a] = static_cast<std::int64_t>(std::floor(p[a] * inv));
+  const auto inv = static_cast<float>(1.0 / voxel_m);
+  const auto key = [inv](const Eigen::Vector3d& p_W) {
+    return vis::voxelKey(p_W.cast<float>(), inv);
   };
   std::unordered_map<std::uint64_t, VoxelVotes> votes;
   bool any_confirmed = false;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     for (const Eigen::Vector3f& p_C : keyframes[k].confirmed_C) {
-      std::int64_t c[3];
-      cell(keyframes[k].T_W_C * p_C.cast<double>(), c);
-      votes[cellKey(c[0], c[1], c[2])].confirm(static_cast<int>(k));
+      votes[key(keyframes[k].T_W_C * p_C.cast<double>())].confirm(static_cast<int>(k));
       any_confirmed = true;
     }
     for (const Eigen::Vector3f& p_C : keyframes[k].moved_C) {
-      std::int64_t c[3];
-      cell(keyframes[k].T_W_C * p_C.cast<double>(), c);
-      votes[cellKey(c[0], c[1], c[2])].move(static_cast<int>(k));
+      votes[key(keyframes[k].T_W_C * p_C.cast<double>())].move(static_cast<int>(k));
     }
   }
   if (!any_confirmed) return out;
@@ -101,14 +88,13 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
       const float* z = kf.depth_m.ptr<float>(v);
       for (int u = 0; u < kf.held.cols; ++u) {
         if (h[u] == 0 || !(z[u] > 0.0f)) continue;
-        std::int64_t c[3];
-        cell(kf.T_W_C * camera.backProject(u, v, z[u]), c);
+        const std::uint64_t at = key(kf.T_W_C * camera.backProject(u, v, z[u]));
         // The most confirmations and the most motion around it (26 neighbours included).
         int confirmed = 0, moved = 0;
         for (int dz = -1; dz <= 1; ++dz) {
           for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
-              const auto it = votes.find(cellKey(c[0] + dx, c[1] + dy, c[2] + dz));
+              const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
               if (it == votes.end()) continue;
               confirmed = std::max(confirmed, it->second.confirmedByOthers(static_cast<int>(k)));
               moved = std::max(moved, it->second.moved);

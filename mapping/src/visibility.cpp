@@ -34,16 +34,6 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-/// 21 bits per axis (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
-std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
-  const auto k = [inv_voxel](float v) {
-    const double cell = std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15);
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << (kAxisBits - 1))) &
-           kAxisMask;
-  };
-  return k(p.x()) | (k(p.y()) << kAxisBits) | (k(p.z()) << (2 * kAxisBits));
-}
-
 /// Runs fn(depth) for every static pixel of a keyframe, in the order forEachStaticPoint() takes.
 template <typename T, typename Fn>
 void forEachStaticPixelT(const VisibilityKeyframe& kf, const Fn& fn) {
@@ -91,7 +81,7 @@ void keyPoints(const PinholeCamera& camera, const VisibilityKeyframe& kf, float 
   out.starts.clear();
   out.points.clear();
   forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
-    const std::uint64_t key = voxelKey(p_W, inv_voxel);
+    const std::uint64_t key = vis::voxelKey(p_W, inv_voxel);
     const auto index = static_cast<std::uint32_t>(out.points.size());
     out.points.push_back(p_W);
     if (!out.runs.empty() && out.runs.back().key == key) {

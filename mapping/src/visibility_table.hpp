@@ -4,6 +4,7 @@
 // dynamap_mapping.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -19,6 +20,16 @@ namespace dynamap::vis {
 
 constexpr int kAxisBits = 21;
 constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
+
+/// 21 bits per axis (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
+inline std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
+  const auto k = [inv_voxel](float v) {
+    const double cell = std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15);
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << (kAxisBits - 1))) &
+           kAxisMask;
+  };
+  return k(p.x()) | (k(p.y()) << kAxisBits) | (k(p.z()) << (2 * kAxisBits));
+}
 
 /// The key of the voxel (dx, dy, dz) cells away from `key`'s (wrapping as voxelKey() does).
 inline std::uint64_t offsetKey(std::uint64_t key, int dx, int dy, int dz) {

@@ -9,7 +9,7 @@
 
 namespace dynamap {
 
-/// One keyframe for reviseHeldMasks(): what its mask held back and what it saw confirmed static.
+/// One keyframe for heldConfirmedElsewhere() (MappingWorker::finish()): what its mask held back and what it saw confirmed static.
 struct HeldKeyframe {
   cv::Mat depth_m;  ///< CV_32FC1 metres (0 = none)
   cv::Mat held;     ///< CV_8UC1, 255 = masked only for lack of evidence that it stands still
