@@ -19,8 +19,6 @@ namespace dynamap {
 namespace {
 
 using vis::BesideMover;
-using vis::kAxisBits;
-using vis::kAxisMask;
 using vis::KeyedPoints;
 using vis::RunElements;
 using vis::SplitTable;
