@@ -69,12 +69,19 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
   std::unordered_map<std::uint64_t, VoxelVotes> votes;
   bool any_confirmed = false;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    // A keyframe counts once per voxel: a point in the voxel of the point before it adds nothing.
+    std::uint64_t last = 0;
+    bool have_last = false;
     for (const Eigen::Vector3f& p_C : keyframes[k].confirmed_C) {
-      votes[key(keyframes[k].T_W_C * p_C.cast<double>())].confirm(static_cast<int>(k));
-      any_confirmed = true;
+      const std::uint64_t at = key(keyframes[k].T_W_C * p_C.cast<double>());
+      if (!have_last || at != last) votes[at].confirm(static_cast<int>(k));
+      last = at, have_last = true, any_confirmed = true;
     }
+    have_last = false;
     for (const Eigen::Vector3f& p_C : keyframes[k].moved_C) {
-      votes[key(keyframes[k].T_W_C * p_C.cast<double>())].move(static_cast<int>(k));
+      const std::uint64_t at = key(keyframes[k].T_W_C * p_C.cast<double>());
+      if (!have_last || at != last) votes[at].move(static_cast<int>(k));
+      last = at, have_last = true;
     }
   }
   if (!any_confirmed) return out;
@@ -83,26 +90,33 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
     if (kf.held.empty() || kf.depth_m.size() != kf.held.size()) continue;
     cv::Mat hit = cv::Mat::zeros(kf.held.size(), CV_8UC1);
     bool any = false;
+    // Neighbouring pixels mostly fall into one voxel (3 cm at 2 m: ~8 pixels): the verdict of the
+    // last voxel looked up is kept.
+    std::uint64_t last_key = 0;
+    bool last_found = false, have_last = false;
     for (int v = 0; v < kf.held.rows; ++v) {
       const std::uint8_t* h = kf.held.ptr<std::uint8_t>(v);
       const float* z = kf.depth_m.ptr<float>(v);
       for (int u = 0; u < kf.held.cols; ++u) {
         if (h[u] == 0 || !(z[u] > 0.0f)) continue;
         const std::uint64_t at = key(kf.T_W_C * camera.backProject(u, v, z[u]));
-        // The most confirmations and the most motion around it (26 neighbours included).
-        int confirmed = 0, moved = 0;
-        for (int dz = -1; dz <= 1; ++dz) {
-          for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
-              if (it == votes.end()) continue;
-              confirmed = std::max(confirmed, it->second.confirmedByOthers(static_cast<int>(k)));
-              moved = std::max(moved, it->second.moved);
+        if (!have_last || at != last_key) {
+          // The most confirmations and the most motion around it (26 neighbours included).
+          int confirmed = 0, moved = 0;
+          for (int dz = -1; dz <= 1; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+              for (int dx = -1; dx <= 1; ++dx) {
+                const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
+                if (it == votes.end()) continue;
+                confirmed = std::max(confirmed, it->second.confirmedByOthers(static_cast<int>(k)));
+                moved = std::max(moved, it->second.moved);
+              }
             }
           }
+          last_key = at, have_last = true;
+          last_found = confirmed >= min_keyframes && confirmed > moved;
         }
-        const bool found = confirmed >= min_keyframes && confirmed > moved;
-        if (found) hit.at<std::uint8_t>(v, u) = 255, any = true;
+        if (last_found) hit.at<std::uint8_t>(v, u) = 255, any = true;
       }
     }
     if (any) out[k] = hit;

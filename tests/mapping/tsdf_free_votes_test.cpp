@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "dynamap/mapping/ply_io.hpp"
@@ -99,20 +100,31 @@ std::vector<Eigen::Vector3f> floorMesh(const BackendParams& params, int n, doubl
 }
 
 /// Share of a 5 cm grid over the floor within 0.5 m of the origin that has a mesh vertex within 5
-/// cm.
+/// cm. The vertices near the floor are bucketed into 5 cm cells; a grid point looks at the 3 x 3
+/// cells around its own (a brute-force search over every vertex took 2 of the 12 s, and most of
+/// the 155 s under ASan + UBSan with coverage instrumentation).
 double floorCoverage(const std::vector<Eigen::Vector3f>& mesh) {
+  constexpr float kReach = 0.05f;
+  const auto cell = [](double v) { return static_cast<int>(std::floor(v / kReach)); };
+  std::map<std::pair<int, int>, std::vector<Eigen::Vector3f>> near_floor;
+  for (const auto& p : mesh) {
+    if (std::fabs(p.z()) < kReach) near_floor[{cell(p.x()), cell(p.y())}].push_back(p);
+  }
   int covered = 0, all = 0;
   for (double y = -1.0; y <= 1.0; y += 0.05) {
     for (double x = -1.0; x <= 1.0; x += 0.05) {
       if (std::max(std::fabs(x), std::fabs(y)) < 0.4) continue;
       ++all;
       const Eigen::Vector3f q(static_cast<float>(x), static_cast<float>(y), 0.0f);
-      for (const auto& p : mesh) {
-        if ((p - q).squaredNorm() < 0.05f * 0.05f) {
-          ++covered;
-          break;
+      bool hit = false;
+      for (int dy = -1; dy <= 1 && !hit; ++dy) {
+        for (int dx = -1; dx <= 1 && !hit; ++dx) {
+          const auto it = near_floor.find({cell(x) + dx, cell(y) + dy});
+          if (it == near_floor.end()) continue;
+          for (const auto& p : it->second) hit = hit || (p - q).squaredNorm() < kReach * kReach;
         }
       }
+      covered += hit ? 1 : 0;
     }
   }
   return static_cast<double>(covered) / all;
