@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include "in_two.hpp"
 #include "visibility_table.hpp"
 
 namespace dynamap {
@@ -40,6 +41,47 @@ struct VoxelVotes {
   }
 };
 
+using Votes = std::unordered_map<std::uint64_t, VoxelVotes>;
+
+/// Keyframe k's held pixels whose voxel (26 neighbours included) at least `min_keyframes` other
+/// keyframes confirmed static, and more than saw motion there; empty if none.
+cv::Mat confirmedHeldPixels(const PinholeCamera& camera, const HeldKeyframe& kf, int k,
+                            const Votes& votes, float inv, int min_keyframes) {
+  if (kf.held.empty() || kf.depth_m.size() != kf.held.size()) return {};
+  cv::Mat hit = cv::Mat::zeros(kf.held.size(), CV_8UC1);
+  bool any = false;
+  // Neighbouring pixels mostly fall into one voxel (3 cm at 2 m: ~8 pixels): the verdict of the
+  // last voxel looked up is kept.
+  std::uint64_t last_key = 0;
+  bool last_found = false, have_last = false;
+  for (int v = 0; v < kf.held.rows; ++v) {
+    const std::uint8_t* h = kf.held.ptr<std::uint8_t>(v);
+    const float* z = kf.depth_m.ptr<float>(v);
+    for (int u = 0; u < kf.held.cols; ++u) {
+      if (h[u] == 0 || !(z[u] > 0.0f)) continue;
+      const std::uint64_t at =
+          vis::voxelKey((kf.T_W_C * camera.backProject(u, v, z[u])).cast<float>(), inv);
+      if (!have_last || at != last_key) {
+        int confirmed = 0, moved = 0;  // the most of each around it
+        for (int dz = -1; dz <= 1; ++dz) {
+          for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+              const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
+              if (it == votes.end()) continue;
+              confirmed = std::max(confirmed, it->second.confirmedByOthers(k));
+              moved = std::max(moved, it->second.moved);
+            }
+          }
+        }
+        last_key = at, have_last = true;
+        last_found = confirmed >= min_keyframes && confirmed > moved;
+      }
+      if (last_found) hit.at<std::uint8_t>(v, u) = 255, any = true;
+    }
+  }
+  return any ? hit : cv::Mat();
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3f> maskPoints(const PinholeCamera& camera, const cv::Mat& depth_m,
@@ -66,7 +108,7 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
   const auto key = [inv](const Eigen::Vector3d& p_W) {
     return vis::voxelKey(p_W.cast<float>(), inv);
   };
-  std::unordered_map<std::uint64_t, VoxelVotes> votes;
+  Votes votes;
   bool any_confirmed = false;
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     // A keyframe counts once per voxel: a point in the voxel of the point before it adds nothing.
@@ -85,42 +127,12 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
     }
   }
   if (!any_confirmed) return out;
-  for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const HeldKeyframe& kf = keyframes[k];
-    if (kf.held.empty() || kf.depth_m.size() != kf.held.size()) continue;
-    cv::Mat hit = cv::Mat::zeros(kf.held.size(), CV_8UC1);
-    bool any = false;
-    // Neighbouring pixels mostly fall into one voxel (3 cm at 2 m: ~8 pixels): the verdict of the
-    // last voxel looked up is kept.
-    std::uint64_t last_key = 0;
-    bool last_found = false, have_last = false;
-    for (int v = 0; v < kf.held.rows; ++v) {
-      const std::uint8_t* h = kf.held.ptr<std::uint8_t>(v);
-      const float* z = kf.depth_m.ptr<float>(v);
-      for (int u = 0; u < kf.held.cols; ++u) {
-        if (h[u] == 0 || !(z[u] > 0.0f)) continue;
-        const std::uint64_t at = key(kf.T_W_C * camera.backProject(u, v, z[u]));
-        if (!have_last || at != last_key) {
-          // The most confirmations and the most motion around it (26 neighbours included).
-          int confirmed = 0, moved = 0;
-          for (int dz = -1; dz <= 1; ++dz) {
-            for (int dy = -1; dy <= 1; ++dy) {
-              for (int dx = -1; dx <= 1; ++dx) {
-                const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
-                if (it == votes.end()) continue;
-                confirmed = std::max(confirmed, it->second.confirmedByOthers(static_cast<int>(k)));
-                moved = std::max(moved, it->second.moved);
-              }
-            }
-          }
-          last_key = at, have_last = true;
-          last_found = confirmed >= min_keyframes && confirmed > moved;
-        }
-        if (last_found) hit.at<std::uint8_t>(v, u) = 255, any = true;
-      }
-    }
-    if (any) out[k] = hit;
-  }
+  // The votes are read only from here on: every other keyframe on the other thread.
+  inTwo([&](int half) {
+    for (std::size_t k = static_cast<std::size_t>(half); k < keyframes.size(); k += 2)
+      out[k] =
+          confirmedHeldPixels(camera, keyframes[k], static_cast<int>(k), votes, inv, min_keyframes);
+  });
   return out;
 }
 

@@ -11,7 +11,13 @@ namespace dynamap {
 namespace {
 
 constexpr double kDepthUnitsPerM = 5000.0;
-constexpr int kHeldStridePx = 2;  ///< confirmed-static points: one per 2 x 2 pixels
+/// The held revision's confirmed-static and moved points: one per square of pixels as wide as a
+/// voxel at this depth (TUM's camera, 3 cm: 4 x 4 pixels; the 27 voxels around a held pixel still
+/// reach a point up to here).
+constexpr double kHeldPointSpacingDepthM = 4.0;
+int heldStridePx(const PinholeCamera& camera, double voxel_m) {
+  return std::max(1, static_cast<int>(voxel_m * camera.fx / kHeldPointSpacingDepthM));
+}
 
 bool movedBeyond(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double trans_m,
                  double rot_rad) {
@@ -167,11 +173,12 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   if (options_.visibility.enabled)
     rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
   if (options_.held_revision_voxel_m > 0.0) {
-    rec.held.confirmed_C = maskPoints(camera_, kf.depth_m, kf.confirmed_mask, kHeldStridePx);
+    const int stride = heldStridePx(camera_, options_.held_revision_voxel_m);
+    rec.held.confirmed_C = maskPoints(camera_, kf.depth_m, kf.confirmed_mask, stride);
     if (!kf.dynamic_mask.empty()) {
       const cv::Mat moved =
           kf.held_mask.empty() ? kf.dynamic_mask : kf.dynamic_mask & ~kf.held_mask;
-      rec.held.moved_C = maskPoints(camera_, kf.depth_m, moved, kHeldStridePx);
+      rec.held.moved_C = maskPoints(camera_, kf.depth_m, moved, stride);
     }
     if (!kf.held_mask.empty() && !kf.dynamic_mask.empty()) {
       rec.held.held = kf.held_mask & kf.dynamic_mask;
