@@ -23,7 +23,9 @@ if ! command -v clang++ >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/
 fi
 GENERATOR=()
 if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
+LINES_ONLY="-O2 -gline-tables-only -DNDEBUG"  # as scripts/sanitize.sh: one build-asan for both
 cmake -S . -B "$BUILD_DIR" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=ON \
   -DDYNAMAP_FUZZ_SECONDS="$SECONDS_PER_TARGET" >/dev/null
 nice -n 19 cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target dynamap_fuzzers

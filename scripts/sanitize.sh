@@ -29,7 +29,11 @@ if ! command -v clang++ >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/
 fi
 GENERATOR=()
 if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
-CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo)
+# Line tables only (file:line in every sanitizer report, no variable info): the libraries
+# compile in 53 s instead of 65 s (TSan, 2 cores). scripts/fuzz.sh configures build-asan alike.
+LINES_ONLY="-O2 -gline-tables-only -DNDEBUG"
+CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY")
 
 run_asan() {
   local dir=${ASAN_BUILD_DIR:-build-asan}
