@@ -57,6 +57,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.dense_depth_range_m", &c.dense_depth_range_m, 0.001, 10.0);
   schema.addDouble("dynamic.dense_grow_m", &c.dense_grow_m, 0.0, 10.0);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
+  schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addInt("dynamic.support_planes", &c.support_planes, 0, 10);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);

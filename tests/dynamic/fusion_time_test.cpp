@@ -150,6 +150,34 @@ TEST(FusionOverTime, AMissedDetectionKeepsItsMaskCarriedByTheFlow) {
   EXPECT_EQ(r.clusters, 0);
 }
 
+// A walker at the left image border walks out of the image; the detector reports nothing more.
+// The carried box's centre now shows only the wall: it masks nothing there (without the check it
+// took the wall, 12-15 k pixels a frame on teddy_dyn_crowd_dev). A walker still there at his own
+// depth, the detector missing him, keeps his mask.
+TEST(FusionOverTime, ACarriedBoxAtTheBorderMasksNoWallOnceItsWalkerLeft) {
+  const cv::Rect walker(0, 150, 70, 250);
+  const auto carried = [&](bool check, bool still_there) {
+    Scene s0;
+    s0.place(walker, 2.f);
+    DynamicConfig c;
+    c.carried_border_exit = check;
+    RegionFusion fusion(c, ClassTable(c));
+    fusion.fuse(FusionMode::kBoth, s0.depth, s0.points, s0.flagged(walker), {box(walker)});
+    Scene s1;
+    if (still_there) s1.place(walker, 2.f);
+    FusionEvidence ev;
+    ev.prev_points = s1.points;  // no flow
+    const FusionResult r = fusion.fuse(FusionMode::kBoth, s1.depth, s1.points,
+                                       still_there ? s1.flagged(walker) : s1.quiet, {}, ev);
+    EXPECT_EQ(r.objects.size(), 1u);
+    EXPECT_TRUE(!r.objects.empty() && r.objects[0].carried);
+    return maskedShare(r.mask, walker);
+  };
+  EXPECT_LT(carried(true, false), 0.01);
+  EXPECT_GT(carried(false, false), 0.95) << "the scene no longer shows what the check is for";
+  EXPECT_GT(carried(true, true), 0.95);
+}
+
 TEST(FusionOverTime, OnlyProvenStaticPointsCarveAMovingRegion) {
   // A walker whose depth cut includes a standing person at the same depth: the standing
   // person's points carve it out only when they are proven static (landmarks over time).

@@ -128,7 +128,8 @@ void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Poi
 }  // namespace
 
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
-                     double* depth_mode_m, double prior_depth_m, const cv::Mat& not_object) {
+                     double* depth_mode_m, double prior_depth_m, const cv::Mat& not_object,
+                     bool prior_only) {
   if (depth_mode_m != nullptr) *depth_mode_m = 0.0;
   const cv::Rect box = box_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
   if (box.width < 4 || box.height < 4) return {};
@@ -140,6 +141,8 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
     z.setTo(0.f, not_object(box));
   }
   double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
+  if (mode <= 0.0 && prior_only && prior_depth_m > 0.0 && depthMode(z(inner), 0.0) > 0.0)
+    return cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (mode <= 0.0) mode = depthMode(z(inner), 0.0);
   if (mode <= 0.0) {
     const bool has_depth = !not_object.empty() && depthMode(depth_m(box)(inner), 0.0) > 0.0;
@@ -264,8 +267,13 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
                                    const std::vector<std::uint8_t>& dyn,
                                    const ObjectTrack* prev) const {
   const double prior = prev != nullptr ? prev->depth_m : 0.0;
-  cv::Mat region =
-      objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior, evidence_->planes);
+  // A carried box at the image border may have lost its object through the border: then it is
+  // the object only at the object's own depth, not at whatever its centre shows now.
+  const bool at_border =
+      box.x <= 0 || box.y <= 0 || box.br().x >= depth_m.cols || box.br().y >= depth_m.rows;
+  const bool prior_only = d.carried && at_border && config_.carried_border_exit;
+  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior,
+                                evidence_->planes, prior_only);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);

@@ -113,6 +113,10 @@ struct DynamicConfig {
   double dense_grow_m = 0.5;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
+  /// Such a carried box at the image border whose centre shows depth, but none within 0.5 m of
+  /// its object's last depth, has lost the object through the border: it masks nothing (false:
+  /// it takes the centre's dominant depth, e.g. the wall behind a person who walked out).
+  bool carried_border_exit = true;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode
   /// Up to this many large planes (floor, walls; found outside the objects each frame) are no
   /// object's pixels: the floor at a walker's feet, a box carried by the flow onto the floor.
