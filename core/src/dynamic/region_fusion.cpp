@@ -141,9 +141,12 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
     z.setTo(0.f, not_object(box));
   }
   double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
-  if (mode <= 0.0 && prior_only && prior_depth_m > 0.0 && depthMode(z(inner), 0.0) > 0.0)
-    return cv::Mat::zeros(depth_m.size(), CV_8UC1);
-  if (mode <= 0.0) mode = depthMode(z(inner), 0.0);
+  if (mode <= 0.0) {
+    mode = depthMode(z(inner), 0.0);
+    // Depth, but none near the prior: with prior_only the object has left the box.
+    if (mode > 0.0 && prior_only && prior_depth_m > 0.0)
+      return cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  }
   if (mode <= 0.0) {
     const bool has_depth = !not_object.empty() && depthMode(depth_m(box)(inner), 0.0) > 0.0;
     return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
