@@ -69,6 +69,35 @@ TEST(MaskLookahead, MarksTheMoverALaterMaskCoversAndNotWhatMovedInFrontLater) {
   EXPECT_EQ(cv::countNonZero(maskSeenLater(camera, no_depth, T_W_K, depth_l, T_W_L, mask_l)), 0);
 }
 
+TEST(MaskLookahead, ALaterMaskTrimmedOffItsWallCarriesNoMarginBack) {
+  // The later mask as the motion filter makes it: the person grown by a 3 px margin, which lies
+  // on the wall around him. Carried back as it is, the margin lands on the keyframe's wall;
+  // trimmed first over the later frame's own depth (marginNotBehind), it does not, and the
+  // person is still covered but for the sliver he moved.
+  PinholeCamera camera;
+  const Board person{-0.2, 0.1, -0.5, 0.6, 1.5};
+  Eigen::Isometry3d T_W_K = Eigen::Isometry3d::Identity(), T_W_L = T_W_K;
+  T_W_L.translation() = Eigen::Vector3d(0.05, 0.0, 0.0);
+  cv::Mat depth_k, mask_k, depth_l, mask_l;
+  render(camera, T_W_K, {person}, {true}, &depth_k, &mask_k);
+  Board moved = person;
+  moved.x0 += 0.03;
+  moved.x1 += 0.03;
+  render(camera, T_W_L, {moved}, {true}, &depth_l, &mask_l);
+  cv::Mat grown;
+  cv::dilate(mask_l, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+
+  const auto carried = [&](const cv::Mat& later) {
+    return maskSeenLater(camera, depth_k, T_W_K, depth_l, T_W_L, later);
+  };
+  const cv::Mat whole = carried(grown);
+  const cv::Mat trimmed = carried(marginNotBehind(grown, depth_l, 3, 0.1));
+  EXPECT_GT(cv::countNonZero(whole & ~mask_k), 1500);  // the margin, on the wall
+  EXPECT_LT(cv::countNonZero(trimmed & ~mask_k), 50);
+  const double person_px = cv::countNonZero(mask_k);
+  EXPECT_GT(cv::countNonZero(trimmed & mask_k) / person_px, 0.85);
+}
+
 TEST(MarginNotBehind, TheMarginLeavesTheWallBehindButKeepsTheOutlineHolesFloorAndSlivers) {
   // A person 2 m away (100 x 200 px) before a wall at 4 m, masked as the motion filter does: his
   // pixels 2 px short on every side, grown by 3 px. A hole without depth touches his right side,
