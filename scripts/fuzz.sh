@@ -1,16 +1,16 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang, ASan + UBSan) into build-asan (the build that
-# scripts/sanitize.sh asan configures the same way, so the two share it) and runs each one for
+# Builds the libFuzzer targets (clang, ASan + UBSan, libraries with coverage instrumentation)
+# into build-fuzz (FUZZ_BUILD_DIR) and runs each one for
 # N seconds (default 10: the CI smoke run; e.g. 600 for a long run), TEST_JOBS (default 2) at
 # a time, niced (each target keeps a core for its N seconds).
 #   scripts/fuzz.sh [seconds-per-target]
-# Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-asan/fuzz/corpus/<target>/.
-# A crash leaves build-asan/fuzz/<target>-crash-* and makes the script fail; turn it into a
+# Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-fuzz/fuzz/corpus/<target>/.
+# A crash leaves build-fuzz/fuzz/<target>-crash-* and makes the script fail; turn it into a
 # regression test (tests/io/fuzz_regression_test.cpp) before fixing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-10}
-BUILD_DIR=${BUILD_DIR:-${ASAN_BUILD_DIR:-build-asan}}
+BUILD_DIR=${BUILD_DIR:-${FUZZ_BUILD_DIR:-build-fuzz}}
 # clang and its sanitizer/libFuzzer runtimes (Debian: clang, libclang-rt-dev); other deps come
 # from scripts/install_deps.sh.
 if ! command -v clang++ >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
@@ -23,7 +23,7 @@ if ! command -v clang++ >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/
 fi
 GENERATOR=()
 if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi
-LINES_ONLY="-O2 -gline-tables-only -DNDEBUG"  # as scripts/sanitize.sh: one build-asan for both
+LINES_ONLY="-O2 -gline-tables-only -DNDEBUG"  # as scripts/sanitize.sh
 cmake -S . -B "$BUILD_DIR" "${GENERATOR[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=ON \
