@@ -65,9 +65,7 @@ void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& track
     }
     // The later mask's margin on its own background (the wall around that frame's outline of a
     // person) would land on the keyframe's background: it is trimmed as the keyframe's own is.
-    if (margin_behind_m > 0.0 && !moving.empty()) {
-      moving = marginNotBehind(moving, frame.depth_m, margin_px, margin_behind_m);
-    }
+    moving = marginNotBehind(moving, frame.depth_m, margin_px, margin_behind_m);
     const cv::Mat later = maskSeenLater(camera, pending->depth_m, pending->T_W_C, frame.depth_m,
                                         tracked.T_W_C, moving);
     if (cv::countNonZero(later) > 0) {  // a new Mat: the tracker's keyframe keeps its own mask
