@@ -59,6 +59,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
+  schema.addDouble("dynamic.person_max_height_m", &c.person_max_height_m, 0.0, 10.0);
   schema.addInt("dynamic.support_planes", &c.support_planes, 0, 10);
   schema.addInt("dynamic.mask_dilation_px", &c.mask_dilation_px, 0, 100);
   schema.addDouble("dynamic.static_carve_radius_px", &c.static_carve_radius_px, 0.0, 1000.0);

@@ -366,10 +366,10 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   evidence.prev_points = m.prev_px;
   if (input.proven_static != nullptr) evidence.proven_static = *input.proven_static;
   if (m.ids.size() == m.cur_px.size()) evidence.point_ids = m.ids;
+  evidence.K = K_;  // a person's size bound needs it with or without a pose
   if (input.has_prior) {
     evidence.has_pose = true;
     cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), evidence.T_W_C);
-    evidence.K = K_;
     keepLastDepth(input);
   }
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);

@@ -129,16 +129,20 @@ void carveStatic(cv::Mat& region, const cv::Rect& box, const std::vector<cv::Poi
 
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band_m,
                      double* depth_mode_m, double prior_depth_m, const cv::Mat& not_object,
-                     bool prior_only) {
+                     bool prior_only, double max_depth_m) {
   if (depth_mode_m != nullptr) *depth_mode_m = 0.0;
   const cv::Rect box = box_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
   if (box.width < 4 || box.height < 4) return {};
   const cv::Rect inner(box.width / 4, box.height * 15 / 100, std::max(1, box.width / 2),
                        std::max(1, box.height * 70 / 100));  // in the box
   cv::Mat z = depth_m(box);
-  if (!not_object.empty()) {
+  const bool cut = !not_object.empty() || max_depth_m > 0.0;
+  if (cut) {
     z = z.clone();
-    z.setTo(0.f, not_object(box));
+    if (!not_object.empty()) z.setTo(0.f, not_object(box));
+    // Farther than max_depth_m the object would be larger than it can be: that surface is
+    // behind it (the wall beside a walker cut by the border, a box left on the wall).
+    if (max_depth_m > 0.0) z.setTo(0.f, z > max_depth_m);
   }
   double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
   if (mode <= 0.0) {
@@ -148,7 +152,7 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
       return cv::Mat::zeros(depth_m.size(), CV_8UC1);
   }
   if (mode <= 0.0) {
-    const bool has_depth = !not_object.empty() && depthMode(depth_m(box)(inner), 0.0) > 0.0;
+    const bool has_depth = cut && depthMode(depth_m(box)(inner), 0.0) > 0.0;
     return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
   }
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
@@ -275,8 +279,16 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
   const bool at_border =
       box.x <= 0 || box.y <= 0 || box.br().x >= depth_m.cols || box.br().y >= depth_m.rows;
   const bool prior_only = d.carried && at_border && config_.carried_border_exit;
+  // A person is no taller than person_max_height_m: a box h pixels tall holds one no farther
+  // than that height seen over h pixels (the box may be cut by the border: then nearer still).
+  static const int kPerson = ClassTable::classIndex("person");
+  const double fy = evidence_->K[1];
+  const double max_depth =
+      d.detection.class_id == kPerson && config_.person_max_height_m > 0.0 && fy > 0.0
+          ? config_.person_max_height_m * fy / box.height
+          : 0.0;
   cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior,
-                                evidence_->planes, prior_only);
+                                evidence_->planes, prior_only, max_depth);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);

@@ -118,6 +118,10 @@ struct DynamicConfig {
   /// it takes the centre's dominant depth, e.g. the wall behind a person who walked out).
   bool carried_border_exit = true;
   double depth_band_m = 0.4;  ///< object pixels: within this of the object's depth mode
+  /// A person's pixels lie no farther than where its box (h pixels tall) would be this tall
+  /// (m; detector boxes are loose): beyond, the box shows what is behind the person (the wall
+  /// beside a walker cut by the border, a carried box left on the wall). 0 = no bound.
+  double person_max_height_m = 2.5;
   /// Up to this many large planes (floor, walls; found outside the objects each frame) are no
   /// object's pixels: the floor at a walker's feet, a box carried by the flow onto the floor.
   /// 0 = off.

@@ -90,9 +90,12 @@ struct FusionResult {
 /// there, the mask is all zero (an empty Mat still means: no depth). With `prior_only` (and a
 /// prior) the mask is all zero too when the centre holds depth but none within 0.5 m of the prior:
 /// the object is no longer in the box (a carried box at the image border it walked out through).
+/// Depth beyond `max_depth_m` (> 0) is never the object's: where the box holds only such depth,
+/// the mask is all zero.
 cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
                      double* depth_mode_m, double prior_depth_m = 0.0,
-                     const cv::Mat& not_object = cv::Mat(), bool prior_only = false);
+                     const cv::Mat& not_object = cv::Mat(), bool prior_only = false,
+                     double max_depth_m = 0.0);
 
 /// Fuses dynamic points and detections into a motion mask, with per-object temporal state
 /// (objects are associated frame to frame by box IoU, boxes moved with the flow).
