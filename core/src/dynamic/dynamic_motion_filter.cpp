@@ -372,6 +372,8 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
     cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), evidence.T_W_C);
     keepLastDepth(input);
   }
+  if (evidence.has_pose && config_.dense_check_frames > 0)
+    evidence.view = depth_history_.newestUpTo(filtered_ - config_.dense_check_frames);
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
   record("fusion", msSince(start));
   start = Clock::now();

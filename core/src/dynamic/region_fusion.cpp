@@ -23,6 +23,7 @@ constexpr float kAnchorWindowM = 0.1f;  ///< ... within this depth step
 constexpr int kBins = 100;              // 0..10 m
 constexpr float kMatchIou = 0.3f;       ///< a detection continues a track above this IoU
 constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelPerObject)
+constexpr int kInPlaceMinSamples = 20;  ///< depth samples needed to call a cluster in place
 
 /// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few. With `near_m` > 0
 /// only depths within kContinuityM of it compete (the object was there a frame ago).
@@ -462,6 +463,15 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
   return result;
 }
 
+bool RegionFusion::inPlaceEarlier(const cv::Mat& depth_m, const cv::Mat& region,
+                                  const cv::Rect& roi) const {
+  const double share = config_.cluster_max_consistent;
+  if (share <= 0.0 || evidence_->view == nullptr || !evidence_->has_pose) return false;
+  const DepthAgreement a = compareWithView(depth_m, region, roi, evidence_->T_W_C, evidence_->K,
+                                           *evidence_->view, DepthCheckOptions());
+  return a.samples >= kInPlaceMinSamples && a.share(a.consistent) >= share;
+}
+
 int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
                                const std::vector<std::uint8_t>& dyn, const cv::Mat& claimed,
                                cv::Mat& mask) const {
@@ -501,6 +511,7 @@ int RegionFusion::growClusters(const cv::Mat& depth_m, const std::vector<cv::Poi
     cv::Mat filled = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     filled(roi).setTo(255, flood(cv::Rect(1, 1, roi.width, roi.height)) == 255);
     carveStatic(filled, roi, points, dyn, proven_, config_.static_carve_radius_px);
+    if (inPlaceEarlier(depth_m, filled, roi)) continue;
     filled = filled(roi);
     if (cv::countNonZero(filled) == 0) {  // no depth: the hull of the points
       std::vector<cv::Point> hull;

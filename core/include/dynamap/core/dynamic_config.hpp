@@ -131,8 +131,13 @@ struct DynamicConfig {
   /// to any dynamic one, and within this radius of it, are not masked: a standing person next to
   /// a walker at the same depth falls into the walker's depth cut. 0 = off.
   double static_carve_radius_px = 24.0;
-  double cluster_radius_px = 40;     ///< dynamic points closer than this form one cluster
-  int min_cluster_points = 4;        ///< smaller clusters outside detections are noise
+  double cluster_radius_px = 40;  ///< dynamic points closer than this form one cluster
+  int min_cluster_points = 4;     ///< smaller clusters outside detections are noise
+  /// A cluster's grown region that the dense check's earlier view (dense_check_frames back, seen
+  /// from the current pose) saw in place, at least this share of its depth samples agreeing, is
+  /// a still surface under false flags (tracks dragged beside a walker, a far poster), not a
+  /// mover: it is not masked. 0 = off (also without dense_check_frames).
+  double cluster_max_consistent = 0.9;
   double flood_depth_step_m = 0.03;  ///< depth continuity of the flood fill from clusters
   double cluster_box_margin = 1.5;   ///< flood fill stays inside cluster box grown by this
 };

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "dynamap/core/dynamic/class_table.hpp"
+#include "dynamap/core/dynamic/depth_check.hpp"
 #include "dynamap/core/dynamic/nms.hpp"
 #include "dynamap/core/dynamic/object_tracks.hpp"
 #include "dynamap/core/dynamic_config.hpp"
@@ -64,6 +65,9 @@ struct FusionEvidence {
   /// CV_8UC1 (empty: none), 255 = pixels on a large plane (floor, wall; findSupportPlanes): no
   /// object's own. A box carried onto the floor, or the floor at a walker's feet, is not masked.
   cv::Mat planes;
+  /// An earlier depth frame and its pose (null: none; needs has_pose): a cluster of dynamic
+  /// points whose grown region that view saw in place is no mover (cluster_max_consistent).
+  const DepthView* view = nullptr;
 };
 
 struct FusionResult {
@@ -138,6 +142,9 @@ class RegionFusion {
   void applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                    const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
                    FusionResult& result) const;
+  /// True if the earlier view (FusionEvidence::view) saw `region` (inside `roi`) in place: at
+  /// least cluster_max_consistent of its depth samples agree with that view.
+  bool inPlaceEarlier(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi) const;
   int growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
                    const std::vector<std::uint8_t>& dyn, const cv::Mat& claimed,
                    cv::Mat& mask) const;
