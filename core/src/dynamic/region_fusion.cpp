@@ -185,7 +185,12 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
                  evidence >= config_.moving_ratio;
   // Its own points followed over time, against the pose from landmarks proven static: within
   // the pose noise (still), clearly off (moved: twice that), or in between (no verdict).
-  const double tau = config_.static_anchor_px;
+  // The pose noise in pixels, or a still person's postural sway (static_anchor_m) seen at its
+  // depth, whichever is larger.
+  const double sway_px =
+      d.depth_m > 0.0 && ev.K[0] > 0.0 ? config_.static_anchor_m * ev.K[0] / d.depth_m : 0.0;
+  const double tau =
+      config_.static_anchor_px > 0.0 ? std::max(config_.static_anchor_px, sway_px) : 0.0;
   const bool anchored = tau > 0.0 && d.anchor.points >= kAnchorMinPoints;
   const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;

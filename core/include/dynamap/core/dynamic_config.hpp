@@ -98,6 +98,9 @@ struct DynamicConfig {
   /// This replaces the centroid test where it applies: a person swaying 5 cm on the spot moves
   /// its points by several pixels, while its centroid wanders that much with occlusion alone.
   double static_anchor_px = 3.0;
+  /// ... or, if larger, this distance (m) seen at the object's depth: a person standing still
+  /// sways a centimetre or so (0 = pixels only).
+  double static_anchor_m = 0.015;
   /// ... and their signed median depth difference within this (m): a sway along the line of
   /// sight. Twice either threshold is motion: the count of quiet frames starts over.
   double static_anchor_depth_m = 0.03;
