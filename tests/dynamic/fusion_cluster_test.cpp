@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "mask_share.hpp"
 
 namespace dynamap {
 namespace {
@@ -33,9 +34,7 @@ struct ClusterScene {
   }
 };
 
-double maskedShare(const cv::Mat& mask, const cv::Rect& r) {
-  return cv::countNonZero(mask(r)) / static_cast<double>(r.area());
-}
+using test::maskedShare;
 
 TEST(ClusterInPlace, AClusterTheEarlierViewSawInPlaceIsNotMasked) {
   ClusterScene s;

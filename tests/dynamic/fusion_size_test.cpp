@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "mask_share.hpp"
 
 namespace dynamap {
 namespace {
@@ -29,9 +30,7 @@ struct BorderScene {
   }
 };
 
-double maskedShare(const cv::Mat& mask, const cv::Rect& r) {
-  return cv::countNonZero(mask(r)) / static_cast<double>(r.area());
-}
+using test::maskedShare;
 
 TEST(PersonSize, ObjectPixelsIgnoreDepthBeyondTheBound) {
   BorderScene s;

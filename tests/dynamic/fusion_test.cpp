@@ -3,6 +3,7 @@
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "mask_share.hpp"
 
 namespace dynamap {
 namespace {
@@ -33,9 +34,7 @@ struct Scene {
   }
 };
 
-double maskedShare(const cv::Mat& mask, const cv::Rect& r) {
-  return cv::countNonZero(mask(r)) / static_cast<double>(r.area());
-}
+using test::maskedShare;
 
 double iouWith(const cv::Mat& mask, const cv::Rect& r) {
   cv::Mat truth = cv::Mat::zeros(mask.size(), CV_8UC1);

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "mask_share.hpp"
 
 namespace dynamap {
 namespace {
@@ -33,9 +34,7 @@ Detection box(const cv::Rect& r) {
   return {cv::Rect2f(r.x - 10, r.y - 10, r.width + 20, r.height + 20), kPerson, 0.9f};
 }
 
-double maskedShare(const cv::Mat& mask, const cv::Rect& r) {
-  return cv::countNonZero(mask(r)) / static_cast<double>(r.area());
-}
+using test::maskedShare;
 
 TEST(FusionOverTime, KeepingAPersonTakesQuietFramesRemovingOneTakesOne) {
   Scene s;

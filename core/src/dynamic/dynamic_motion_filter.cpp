@@ -292,7 +292,7 @@ void DynamicMotionFilter::keepLastDepth(const MotionFilterInput& input) {
 
 void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence,
                                          FusionResult& fused) {
-  const DepthView* view = depth_history_.newestUpTo(filtered_ - config_.dense_check_frames);
+  const DepthView* view = evidence.view;  // the same earlier view fusion's clusters were held to
   if (view == nullptr || depth_m.empty()) return;
   SeenThroughOptions o;
   o.min_region_px = config_.dense_min_region_px;
