@@ -1,7 +1,9 @@
 #include "dynamap/mapping/mask_lookahead.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -34,7 +36,10 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
   const int w = later_mask.cols, h = later_mask.rows;
   // Every 2nd pixel of every 2nd row, marking its 2 x 2 block: a quarter of the projections.
   constexpr int kStride = 2;
-  const cv::Rect image(0, 0, out.cols, out.rows);
+  std::vector<float> x_n(static_cast<std::size_t>(depth_m.cols));
+  for (int u = 0; u < depth_m.cols; u += kStride) {
+    x_n[static_cast<std::size_t>(u)] = (static_cast<float>(u) - cx) / fx;
+  }
   for (int v = 0; v < depth_m.rows; v += kStride) {
     const float* z_row = depth_m.ptr<float>(v);
     const float y_n = (static_cast<float>(v) - cy) / fy;
@@ -42,7 +47,7 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       const float z = z_row[u];
       if (!(z > 0.0f)) continue;
       const Eigen::Vector3f p =
-          R * Eigen::Vector3f((static_cast<float>(u) - cx) / fx * z, y_n * z, z) + t;
+          R * Eigen::Vector3f(x_n[static_cast<std::size_t>(u)] * z, y_n * z, z) + t;
       if (p.z() <= 0.1f) continue;
       const int ul = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
       const int vl = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
@@ -50,7 +55,10 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       if (later_mask.at<std::uint8_t>(vl, ul) == 0) continue;
       const float seen = later_depth_m.at<float>(vl, ul);
       if (seen > 0.0f && seen >= p.z() - margin) {
-        out(cv::Rect(u, v, kStride, kStride) & image).setTo(255);
+        for (int y = v; y < std::min(v + kStride, out.rows); ++y) {
+          std::uint8_t* row = out.ptr<std::uint8_t>(y);
+          for (int x = u; x < std::min(u + kStride, out.cols); ++x) row[x] = 255;
+        }
       }
     }
   }
@@ -65,16 +73,23 @@ cv::Mat marginNotBehind(const cv::Mat& mask, const cv::Mat& depth_m, int radius_
   // The mask's core (what the margin was grown from) and the farthest depth of the core within
   // the margin of each pixel; pixels with no core that near (a sliver a later frame's mask
   // added) stay as they are.
+  // Only the mask's bounding box grown by the radius is worked on: every pixel of the mask has
+  // its whole disc there, and outside the mask nothing changes.
+  cv::Mat out = mask.clone();
+  const cv::Rect bound = cv::boundingRect(mask);
+  if (bound.area() == 0) return out;
+  const cv::Rect roi = cv::Rect(bound.x - radius_px, bound.y - radius_px,
+                                bound.width + 2 * radius_px, bound.height + 2 * radius_px) &
+                       cv::Rect(0, 0, mask.cols, mask.rows);
   const int k = 2 * radius_px + 1;
   const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k});
   cv::Mat core;
-  cv::erode(mask, core, disc);
-  cv::Mat core_depth = cv::Mat::zeros(depth_m.size(), CV_32FC1);
-  depth_m.copyTo(core_depth, core);
+  cv::erode(mask(roi), core, disc);
+  cv::Mat core_depth = cv::Mat::zeros(roi.size(), CV_32FC1);
+  depth_m(roi).copyTo(core_depth, core);
   cv::Mat farthest;
   cv::dilate(core_depth, farthest, disc);
-  cv::Mat out = mask.clone();
-  out.setTo(0, (depth_m > farthest + behind_m) & (farthest > 0.f));
+  out(roi).setTo(0, (depth_m(roi) > farthest + behind_m) & (farthest > 0.f));
   return out;
 }
 

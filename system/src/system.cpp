@@ -177,6 +177,11 @@ TrackOutput System::track(const RgbdFrame& frame) {
   return out;
 }
 
+void System::prefetch(const RgbdFrame& next) {
+  auto& s = *impl_;
+  if (s.tracker && s.motion_filter && !next.depth_m.empty()) s.motion_filter->prefetch(next);
+}
+
 void System::markBadFrame(double timestamp_s) {
   auto& s = *impl_;
   ++s.counts.frames;

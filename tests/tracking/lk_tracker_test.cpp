@@ -55,5 +55,33 @@ TEST(LkTracker, ForwardBackwardCheckRejectsUntrackablePoints) {
   EXPECT_EQ(ok[0] + ok[1], 0);
 }
 
+TEST(LkTracker, TwoThreadsTrackEveryPointAsOneDoes) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 7);
+  scene.addPlane({-2.0, -1.5, 1.5}, {4.0, 0, 0}, {0, 3.0, 0});
+  const auto frame = scene.render(Eigen::Isometry3d::Identity(), 0.0);
+  cv::Mat gray, moved;
+  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+  const cv::Matx23d M(1, 0, 3.2, 0, 1, 1.7);
+  cv::warpAffine(gray, moved, M, gray.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  std::vector<cv::Point2f> prev_px;
+  cv::goodFeaturesToTrack(gray, prev_px, 400, 0.01, 8);
+  ASSERT_GT(prev_px.size(), 200u);
+
+  TrackerConfig one, two;
+  one.lk_threads = 1;
+  two.lk_threads = 2;
+  const LkPyramid a = LkTracker(one).buildPyramid(gray), b = LkTracker(one).buildPyramid(moved);
+  std::vector<cv::Point2f> px_one = prev_px, px_two = prev_px;
+  std::vector<std::uint8_t> ok_one, ok_two;
+  LkTracker(one).track(a, b, prev_px, px_one, ok_one);
+  LkTracker(two).track(a, b, prev_px, px_two, ok_two);
+  ASSERT_EQ(ok_two.size(), ok_one.size());
+  for (std::size_t i = 0; i < prev_px.size(); ++i) {
+    EXPECT_EQ(ok_two[i], ok_one[i]) << i;
+    EXPECT_EQ(px_two[i], px_one[i]) << i;  // bit for bit
+  }
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -126,7 +126,13 @@ void Pipeline::processFrames(RunResult& result) {
     return start +
            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s));
   };
-  FramePrefetcher frames(sequence_);
+  // Offline, the detector may start on the next frame as soon as it is read (it is the next
+  // one tracked); --realtime may skip frames, so it does not read ahead.
+  auto& s = *stages_;
+  FramePrefetcher frames(
+      sequence_, options_.realtime || s.given_poses
+                     ? std::function<void(const RgbdFrame&)>()
+                     : [&s](const RgbdFrame& next) { s.system->prefetch(next); });
   for (std::size_t i = 0; i < total; ++i) {
     if (interruptRequested()) {
       result.status = "interrupted";

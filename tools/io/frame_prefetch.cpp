@@ -17,8 +17,11 @@ FrameLoad FramePrefetcher::take(std::size_t index) {
   }
   if (index + 1 < sequence_.size()) {
     pending_index_ = index + 1;
-    pending_ =
-        std::async(std::launch::async, [this, next = index + 1] { return sequence_.load(next); });
+    pending_ = std::async(std::launch::async, [this, next = index + 1] {
+      FrameLoad next_load = sequence_.load(next);
+      if (next_load.ok && on_read_) on_read_(next_load.frame);
+      return next_load;
+    });
   }
   return load;
 }

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <future>
+#include <utility>
 
 #include "tum_dataset.hpp"
 
@@ -13,7 +15,10 @@ namespace dynamap {
 /// TumSequence::load(i) would (same bytes, same errors) and starts reading i + 1.
 class FramePrefetcher {
  public:
-  explicit FramePrefetcher(const TumSequence& sequence) : sequence_(sequence) {}
+  /// `on_read`, if given, receives each frame read ahead that loaded, on the reading thread.
+  explicit FramePrefetcher(const TumSequence& sequence,
+                           std::function<void(const RgbdFrame&)> on_read = {})
+      : sequence_(sequence), on_read_(std::move(on_read)) {}
   ~FramePrefetcher();
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;
@@ -23,6 +28,7 @@ class FramePrefetcher {
 
  private:
   const TumSequence& sequence_;
+  std::function<void(const RgbdFrame&)> on_read_;
   std::future<FrameLoad> pending_;
   std::size_t pending_index_ = 0;
 };

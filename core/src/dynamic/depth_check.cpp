@@ -34,13 +34,14 @@ Verdict judge(const cv::Mat& view_depth, int u, int v, int slack, float z, float
   return nearest > z + margin ? Verdict::kSeenThrough : Verdict::kOccluded;
 }
 
-/// Median depth of the sampled pixels of group `label` (0 if none has depth).
-double groupDepth(const cv::Mat& depth_m, const cv::Mat& labels, int label, const cv::Rect& box,
-                  int step) {
+/// Median depth of the sampled pixels of group `label` (0 if none has depth); `labels` covers
+/// the image from `origin` on.
+double groupDepth(const cv::Mat& depth_m, const cv::Mat& labels, cv::Point origin, int label,
+                  const cv::Rect& box, int step) {
   std::vector<float> z;
   for (int y = box.y + step / 2; y < box.y + box.height; y += step) {
     for (int x = box.x + step / 2; x < box.x + box.width; x += step) {
-      if (labels.at<int>(y, x) == label && depth_m.at<float>(y, x) > 0.f) {
+      if (labels.at<int>(y - origin.y, x - origin.x) == label && depth_m.at<float>(y, x) > 0.f) {
         z.push_back(depth_m.at<float>(y, x));
       }
     }
@@ -78,8 +79,6 @@ float windowInteriorDepth(const cv::Mat& depth_m, int x, int y, int radius_px, f
   }
   return z;
 }
-
-double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
 
 DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi,
                                const cv::Matx44d& T_W_C, const cv::Vec4d& K, const DepthView& view,
@@ -156,15 +155,20 @@ cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, con
   compareWithView(depth_m, cv::Mat(), cv::Rect(0, 0, depth_m.cols, depth_m.rows), T_W_C, K, view,
                   o.check, &seen);
   if (!exclude.empty()) seen.setTo(0, exclude);
+  // Groups are found only where there is anything (most frames see through little or nothing);
+  // each group is handled on its own, so the order of their labels does not matter.
+  const cv::Rect bound = cv::boundingRect(seen);
+  if (bound.area() == 0) return out;
   cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(seen, labels, stats, centroids, 8, CV_32S);
+  const int n = cv::connectedComponentsWithStats(seen(bound), labels, stats, centroids, 8, CV_32S);
   const cv::Rect image(0, 0, depth_m.cols, depth_m.rows);
   const int step = std::max(1, o.check.stride_px);
   for (int c = 1; c < n; ++c) {
     if (stats.at<int>(c, cv::CC_STAT_AREA) < o.min_region_px) continue;
-    const cv::Rect tight(stats.at<int>(c, cv::CC_STAT_LEFT), stats.at<int>(c, cv::CC_STAT_TOP),
+    const cv::Rect tight(bound.x + stats.at<int>(c, cv::CC_STAT_LEFT),
+                         bound.y + stats.at<int>(c, cv::CC_STAT_TOP),
                          stats.at<int>(c, cv::CC_STAT_WIDTH), stats.at<int>(c, cv::CC_STAT_HEIGHT));
-    const double z = groupDepth(depth_m, labels, c, tight, step);
+    const double z = groupDepth(depth_m, labels, bound.tl(), c, tight, step);
     if (z <= 0.0) continue;
     const int gw = cvRound(o.grow_m * K[0] / z), gh = cvRound(o.grow_m * K[1] / z);
     const cv::Rect roi =
@@ -175,7 +179,7 @@ cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, con
     const cv::Scalar tol(o.depth_range_m);
     for (int y = tight.y + step / 2; y < tight.y + tight.height; y += step) {
       for (int x = tight.x + step / 2; x < tight.x + tight.width; x += step) {
-        if (labels.at<int>(y, x) != c) continue;
+        if (labels.at<int>(y - bound.y, x - bound.x) != c) continue;
         const cv::Point p(x - roi.x, y - roi.y);
         if (depth_roi.at<float>(p) <= 0.f || flood.at<uchar>(p.y + 1, p.x + 1) != 0) continue;
         cv::floodFill(depth_roi, flood, p, cv::Scalar(), nullptr, tol, tol,

@@ -1,5 +1,6 @@
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 
+#include "dynamap/core/dynamic/detector_worker.hpp"
 #include "dynamap/core/dynamic/support_planes.hpp"
 
 #include <algorithm>
@@ -40,106 +41,6 @@ bool inMask(const cv::Mat& mask, const cv::Point2f& p) {
 
 }  // namespace
 
-/// Runs the detector on its own thread, one frame in flight. Frames carry the filter's frame
-/// number so that results can be aged.
-class DynamicMotionFilter::Worker {
- public:
-  using Result = DynamicMotionFilter::LatestDetections;
-
-  Worker(std::unique_ptr<ObjectDetector> detector, int threads, DynamicMotionFilter* owner)
-      : detector_(std::move(detector)),
-        owner_(owner),
-        thread_((applyThreads(threads), [this] { loop(); })) {}
-  ~Worker() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    cv_.notify_all();
-    thread_.join();
-  }
-  /// Hands the frame over if the thread is idle (or, with `wait`, once it is); false = skipped.
-  bool submit(const cv::Mat& bgr, long frame_no, double stamp, bool wait) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (wait) cv_.wait(lock, [&] { return !has_job_ && !busy_; });
-    if (has_job_ || busy_) return false;
-    job_ = bgr.clone();
-    job_frame_ = frame_no;
-    job_stamp_ = stamp;
-    has_job_ = true;
-    cv_.notify_all();
-    return true;
-  }
-  /// The newest finished result not yet taken (false if none); with `wait`, first waits for the
-  /// frame in flight. Rethrows a detector error.
-  bool take(Result* out, bool wait) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (wait) cv_.wait(lock, [&] { return !has_job_ && !busy_; });
-    if (!has_result_) return false;
-    has_result_ = false;
-    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
-    *out = std::move(result_);
-    return true;
-  }
-  std::vector<Detection> runNow(const cv::Mat& bgr) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [&] { return !has_job_ && !busy_; });
-    has_result_ = false;
-    const auto start = Clock::now();
-    auto dets = detector_->detect(bgr);
-    owner_->record("detector", msSince(start));
-    return dets;
-  }
-
- private:
-  /// OpenCV's pool size is set before the worker thread and any tracking start: set from the
-  /// worker itself, it changed under the tracker's first ORB/LK calls at a moment that depended
-  /// on thread timing, and a loaded machine then gave other keypoints (other trajectories).
-  static void applyThreads(int threads) {
-    if (threads > 0) cv::setNumThreads(threads);
-  }
-  void loop() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (true) {
-      cv_.wait(lock, [&] { return stop_ || has_job_; });
-      if (stop_) return;
-      cv::Mat job = std::move(job_);
-      Result result;
-      result.frame_no = job_frame_;
-      result.stamp = job_stamp_;
-      has_job_ = false;
-      busy_ = true;
-      lock.unlock();
-      std::exception_ptr error;
-      const auto start = Clock::now();
-      try {
-        result.detections = detector_->detect(job);
-      } catch (...) {
-        error = std::current_exception();
-      }
-      owner_->record("detector", msSince(start));
-      lock.lock();
-      result_ = std::move(result);
-      error_ = error;
-      busy_ = false;
-      has_result_ = true;
-      cv_.notify_all();
-    }
-  }
-
-  std::unique_ptr<ObjectDetector> detector_;
-  DynamicMotionFilter* owner_;
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  cv::Mat job_;
-  long job_frame_ = -1;
-  double job_stamp_ = 0.0;
-  bool has_job_ = false, busy_ = false, has_result_ = false, stop_ = false;
-  Result result_;
-  std::exception_ptr error_;
-  std::thread thread_;  // last: starts after every other member is ready
-};
-
 DetectorOptions detectorOptions(const DynamicConfig& c) {
   DetectorOptions o;
   o.kind = c.detector;
@@ -168,8 +69,9 @@ DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config, const Pinh
       timing_(timing),
       depth_history_(2 * config.dense_check_frames) {
   if (mode_ != FusionMode::kGeometry && config.detector != "none") {
-    worker_ = std::make_unique<Worker>(makeObjectDetector(detectorOptions(config), classes_),
-                                       config.detector_threads, this);
+    worker_ = std::make_unique<DetectorWorker>(
+        makeObjectDetector(detectorOptions(config), classes_), config.detector_threads,
+        [this](double ms) { record("detector", ms); });
   }
 }
 
@@ -194,13 +96,25 @@ void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
   }
 }
 
+void DynamicMotionFilter::prefetch(const RgbdFrame& next) {
+  // Only lockstep runs read ahead: there the frame after this one is always begun next.
+  if (!worker_ || !lockstep() || next.bgr.empty()) return;
+  worker_->prefetch(next.bgr, next.timestamp_s);
+}
+
 bool DynamicMotionFilter::lockstep() const {
   return config_.detector_async && config_.detector_lockstep;
 }
 
 void DynamicMotionFilter::takeDetections(bool wait) {
   const auto start = Clock::now();
-  if (worker_->take(&latest_, wait)) record("detector_fresh", 0.0);
+  DetectorWorker::Result result;
+  if (worker_->take(&result, wait)) {
+    latest_.detections = std::move(result.detections);
+    latest_.frame_no = result.frame_no;
+    latest_.stamp = result.stamp;
+    record("detector_fresh", 0.0);
+  }
   record("detector_wait", msSince(start));
 }
 

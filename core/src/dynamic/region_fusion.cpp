@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 
 #include <opencv2/imgproc.hpp>
@@ -300,9 +301,22 @@ cv::Mat RegionFusion::objectRegion(const cv::Mat& depth_m, const cv::Rect& box, 
     region(box).setTo(255);
   }
   if (evidence_->has_pose && d.depth_m > 0.0) {
-    const cv::Moments m = cv::moments(region(box), true);
-    if (m.m00 > 0.0) {
-      const double u = box.x + m.m10 / m.m00, v = box.y + m.m01 / m.m00, z = d.depth_m;
+    // The region's centroid in the box (cv::moments' m00, m10, m01 of the binary region: sums
+    // of whole numbers, exact in either form; the other seven moments are not needed).
+    std::int64_t m00 = 0, m10 = 0, m01 = 0;
+    for (int y = 0; y < box.height; ++y) {
+      const uchar* row = region.ptr<uchar>(box.y + y) + box.x;
+      std::int64_t count = 0, sum_x = 0;
+      for (int x = 0; x < box.width; ++x) {
+        const int on = row[x] != 0 ? 1 : 0;
+        count += on;
+        sum_x += on * x;
+      }
+      m00 += count, m10 += sum_x, m01 += count * y;
+    }
+    if (m00 > 0) {
+      const double u = box.x + static_cast<double>(m10) / static_cast<double>(m00);
+      const double v = box.y + static_cast<double>(m01) / static_cast<double>(m00), z = d.depth_m;
       const cv::Vec4d& K = evidence_->K;
       const cv::Vec4d p_C((u - K[2]) / K[0] * z, (v - K[3]) / K[1] * z, z, 1.0);
       const cv::Vec4d p_W = evidence_->T_W_C * p_C;
@@ -346,10 +360,16 @@ void RegionFusion::applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& regi
   if (d.moving && mode == FusionMode::kBoth) {
     carveStatic(region, box, points, dyn, proven_, config_.static_carve_radius_px);
   }
-  (d.moving ? result.mask : result.static_objects) |= region;
-  if (d.moving) (d.unconfirmed ? result.unconfirmed : certain_) |= region;
-  if (d.moving) (d.motion_now || mode != FusionMode::kBoth ? evidenced_ : result.held) |= region;
-  if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) confirmed_ |= region;
+  // The region lies in its box: only the box of each mask is touched.
+  const cv::Mat in_box = region(box);
+  const auto add = [&](const cv::Mat& mask) {  // writes into mask's pixels
+    cv::Mat roi = mask(box);
+    roi |= in_box;
+  };
+  add(d.moving ? result.mask : result.static_objects);
+  if (d.moving) add(d.unconfirmed ? result.unconfirmed : certain_);
+  if (d.moving) add(d.motion_now || mode != FusionMode::kBoth ? evidenced_ : result.held);
+  if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) add(confirmed_);
   result.objects.push_back(d);
 }
 
@@ -422,7 +442,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
         if (prev != nullptr) matched[track] = true;
         next.push_back(decideObject(d, prev, evidence));
       }
-      claimed |= region;
+      claimed(box) |= region(box);
       applyObject(mode, d, region, box, points, dyn, result);
     }
     // Objects the detector did not report in this frame: a person seen a moment ago keeps its
@@ -439,7 +459,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
       cv::Mat region = objectRegion(depth_m, box, d, points, dyn, &track);
       next.push_back(decideObject(d, &track, evidence));
       next.back().missed = track.missed + 1;
-      claimed |= region;
+      claimed(box) |= region(box);
       applyObject(mode, d, region, box, points, dyn, result);
     }
   }

@@ -118,12 +118,18 @@ cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vecto
                     const SupportPlaneOptions& o) {
   cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (planes.empty()) return out;
+  // The back-projection's per-column and per-row factors, computed once (as sample() does).
+  std::vector<double> fx(static_cast<std::size_t>(depth_m.cols));
+  for (int x = 0; x < depth_m.cols; ++x) fx[static_cast<std::size_t>(x)] = (x - K[2]) / K[0];
   for (int y = 0; y < depth_m.rows; ++y) {
     const float* z_row = depth_m.ptr<float>(y);
     uchar* out_row = out.ptr<uchar>(y);
+    const double fy = (y - K[3]) / K[1];
     for (int x = 0; x < depth_m.cols; ++x) {
       if (z_row[x] <= 0.f) continue;
-      const Sample s = sample(x, y, z_row[x], K, o);
+      const double z = z_row[x];
+      const Sample s{cv::Vec3d(fx[static_cast<std::size_t>(x)] * z, fy * z, z),
+                     std::clamp(o.noise_sigmas * depthNoiseM(z), o.min_margin_m, o.max_margin_m)};
       for (const auto& plane : planes) {
         if (onPlane(s, plane)) {
           out_row[x] = 255;

@@ -1,6 +1,7 @@
 #include "dynamap/core/tracking/lk_tracker.hpp"
 
 #include <algorithm>
+#include <future>
 
 #include <opencv2/video/tracking.hpp>
 
@@ -10,7 +11,8 @@ LkTracker::LkTracker(const TrackerConfig& config)
     : window_(config.lk_window_px, config.lk_window_px),
       max_level_(std::max(0, config.lk_levels - 1)),
       max_iterations_(config.lk_max_iterations),
-      fb_threshold_px_(config.lk_fb_threshold_px) {}
+      fb_threshold_px_(config.lk_fb_threshold_px),
+      threads_(config.lk_threads) {}
 
 LkPyramid LkTracker::buildPyramid(const cv::Mat& gray) const {
   LkPyramid pyramid;
@@ -23,6 +25,26 @@ void LkTracker::track(const LkPyramid& prev, const LkPyramid& cur,
                       std::vector<std::uint8_t>& ok) const {
   ok.assign(prev_px.size(), 0);
   if (prev_px.empty() || prev.empty() || cur.empty()) return;
+  // Each point is tracked on its own, so the points split over threads give the same result.
+  const std::size_t n = prev_px.size();
+  if (threads_ < 2 || n < kMinPointsPerThread * 2) {
+    trackRange(prev, cur, prev_px, cur_px, ok, 0, n);
+    return;
+  }
+  const std::size_t half = n / 2;
+  auto first =
+      std::async(std::launch::async, [&] { trackRange(prev, cur, prev_px, cur_px, ok, 0, half); });
+  trackRange(prev, cur, prev_px, cur_px, ok, half, n);
+  first.get();
+}
+
+void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
+                           const std::vector<cv::Point2f>& all_prev_px,
+                           std::vector<cv::Point2f>& all_cur_px, std::vector<std::uint8_t>& all_ok,
+                           std::size_t begin, std::size_t end) const {
+  const auto b = static_cast<std::ptrdiff_t>(begin), e = static_cast<std::ptrdiff_t>(end);
+  const std::vector<cv::Point2f> prev_px(all_prev_px.begin() + b, all_prev_px.begin() + e);
+  std::vector<cv::Point2f> cur_px(all_cur_px.begin() + b, all_cur_px.begin() + e);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, max_iterations_,
                                   0.01);
   std::vector<std::uint8_t> fwd_status, bwd_status;
@@ -35,6 +57,7 @@ void LkTracker::track(const LkPyramid& prev, const LkPyramid& cur,
   const cv::Size size = cur.front().size();
   const double fb2 = fb_threshold_px_ * fb_threshold_px_;
   for (std::size_t i = 0; i < prev_px.size(); ++i) {
+    all_cur_px[begin + i] = cur_px[i];
     if (!fwd_status[i] || !bwd_status[i]) continue;
     const cv::Point2f d = back_px[i] - prev_px[i];
     if (d.dot(d) > fb2) continue;
@@ -43,7 +66,7 @@ void LkTracker::track(const LkPyramid& prev, const LkPyramid& cur,
         p.y > static_cast<float>(size.height - 1)) {
       continue;
     }
-    ok[i] = 1;
+    all_ok[begin + i] = 1;
   }
 }
 

@@ -99,6 +99,10 @@ class System {
   TrackOutput track(const RgbdFrame& frame);
   /// A frame that could not be read: counted, no pose.
   void markBadFrame(double timestamp_s);
+  /// The prepared frame that will be passed to track() next, as soon as it is read: the
+  /// detector may start on it while the current frame is tracked (offline lockstep runs; the
+  /// results are those without it). Optional. Thread-safe with track(); not after finish().
+  void prefetch(const RgbdFrame& next);
   /// Given-pose mapping (SystemOptions::given_poses): every frame is a keyframe with pose
   /// `T_W_C` and dynamic mask `mask` (CV_8UC1 255 = moving, may be empty).
   TrackOutput mapWithPose(const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,

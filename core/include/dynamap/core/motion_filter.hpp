@@ -58,13 +58,17 @@ struct MotionFilterOutput {
 /// Hook between feature matching and pose estimation. The tracker drops dynamic matches and
 /// every feature inside `dynamic_mask` from pose estimation, bundle adjustment and new
 /// landmarks, and attaches the mask to keyframe packets.
-/// Called from the tracking thread only; implementations need not be thread-safe.
+/// Called from the tracking thread only (prefetch() excepted); need not be thread-safe otherwise.
 class MotionFilter {
  public:
   virtual ~MotionFilter() = default;
   /// Called at the start of Tracker::track(), before feature matching, so that slow work
   /// (e.g. the object detector) can run on its own thread while the tracker matches features.
   virtual void beginFrame(const RgbdFrame& frame) = 0;
+  /// The frame that will be begun next, as soon as it is read (before the current frame is
+  /// done), so that slow work on it may start early. Optional; may be called from another
+  /// thread than the tracking one (implementations that use it must be thread-safe there).
+  virtual void prefetch(const RgbdFrame& next) { (void)next; }
   /// Called between matching and pose estimation with the frame passed to beginFrame().
   virtual MotionFilterOutput filter(const MotionFilterInput& input) = 0;
 };

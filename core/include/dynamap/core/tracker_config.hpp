@@ -20,6 +20,9 @@ struct TrackerConfig {
   int lk_window_px = 15;            ///< LK window side
   int lk_max_iterations = 20;       ///< LK iterations per level
   double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
+  /// Threads LK splits a frame's points over (each point is tracked alone: same result with
+  /// any number). 2 helps where a core is free; on 2 cores the detector already fills it.
+  int lk_threads = 1;
 
   // --- motion probes (only with a motion filter) ---
   /// Extra LK points, not landmarks, appended to the matches handed to the motion filter so that

@@ -42,7 +42,7 @@ struct DepthCheckOptions {
 
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
 /// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi, Lovell 2012, for the Kinect).
-double depthNoiseM(double z_m);
+inline double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
 
 /// Depth at (x, y) unless it has none or a 4-neighbour 4 px away is outside the image, has no
 /// depth or differs by more than 0.1 m (a depth edge); else 0. A point on an occlusion edge

@@ -17,6 +17,8 @@
 
 namespace dynamap {
 
+class DetectorWorker;
+
 /// Everything the last filter() call saw and decided (for debug images and benchmarks).
 struct MotionDiagnostics {
   FeatureMatches matches;
@@ -50,6 +52,9 @@ class DynamicMotionFilter : public MotionFilter {
   DynamicMotionFilter& operator=(const DynamicMotionFilter&) = delete;
 
   void beginFrame(const RgbdFrame& frame) override;
+  /// Lockstep runs (detector_async && detector_lockstep): the detector starts on `next` behind
+  /// the frame in flight. Thread-safe.
+  void prefetch(const RgbdFrame& next) override;
   MotionFilterOutput filter(const MotionFilterInput& input) override;
 
   const MotionDiagnostics& lastDiagnostics() const { return diagnostics_; }
@@ -58,7 +63,6 @@ class DynamicMotionFilter : public MotionFilter {
   const ClassTable& classTable() const { return classes_; }
 
  private:
-  class Worker;
   void record(const std::string& stage, double ms);
   std::vector<Detection> currentDetections(const RgbdFrame* frame, const FeatureMatches& m);
   bool lockstep() const;  ///< detector_async && detector_lockstep
@@ -84,7 +88,7 @@ class DynamicMotionFilter : public MotionFilter {
   FusionMode mode_;
   ClassTable classes_;
   RegionFusion fusion_;
-  std::unique_ptr<Worker> worker_;  ///< null when no detector is used
+  std::unique_ptr<DetectorWorker> worker_;  ///< null when no detector is used
   struct LatestDetections {
     std::vector<Detection> detections;
     long frame_no = -1;  ///< frame number (beginFrame() count) they were computed on

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -26,10 +27,17 @@ class LkTracker {
              std::vector<cv::Point2f>& cur_px, std::vector<std::uint8_t>& ok) const;
 
  private:
+  static constexpr std::size_t kMinPointsPerThread = 32;
+  /// Tracks points [begin, end) of the vectors (ok and cur_px written there only).
+  void trackRange(const LkPyramid& prev, const LkPyramid& cur,
+                  const std::vector<cv::Point2f>& prev_px, std::vector<cv::Point2f>& cur_px,
+                  std::vector<std::uint8_t>& ok, std::size_t begin, std::size_t end) const;
+
   cv::Size window_;
   int max_level_;
   int max_iterations_;
   double fb_threshold_px_;
+  int threads_;
 };
 
 }  // namespace dynamap
