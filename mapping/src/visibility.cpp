@@ -204,12 +204,15 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic
   const int f = view.downsample;
   cv::Mat d = depth_m.clone();
   d.setTo(kNoReading, ~(d > 0.0f));
-  cv::Mat block(depth_m.rows / f, depth_m.cols / f, CV_32FC1);
+  cv::Mat block(depth_m.rows / f, depth_m.cols / f, CV_32FC1);  // each f x f block's minimum
   for (int v = 0; v < block.rows; ++v) {
-    for (int u = 0; u < block.cols; ++u) {
-      double lo = 0.0;
-      cv::minMaxLoc(d(cv::Rect(u * f, v * f, f, f)), &lo);
-      block.at<float>(v, u) = static_cast<float>(lo);
+    float* out = block.ptr<float>(v);
+    for (int u = 0; u < block.cols; ++u) out[u] = d.at<float>(v * f, u * f);
+    for (int y = v * f; y < (v + 1) * f; ++y) {
+      const float* row = d.ptr<float>(y);
+      for (int u = 0; u < block.cols; ++u) {
+        for (int x = u * f; x < (u + 1) * f; ++x) out[u] = std::min(out[u], row[x]);
+      }
     }
   }
   cv::erode(block, block, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
