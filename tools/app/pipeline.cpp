@@ -195,7 +195,7 @@ void Pipeline::processFrame(std::size_t index, const FrameLoad& load, RunResult&
   if (tracked.is_keyframe) {
     keyframe_entry_[tracked.keyframe->id] = index;
     if (!gt_masks_dir_.empty())
-      if (const auto score = scoreKeyframeMask(entry, tracked.keyframe->dynamic_mask))
+      if (const auto score = scoreKeyframeMask(entry, tracked.keyframe->dynamic_mask, true))
         result.tracker_mask_scores.add(*score);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
@@ -228,10 +228,18 @@ void Pipeline::revisedKeyframeMasks(RunResult& result) {
 }
 
 std::optional<MaskFrameScore> Pipeline::scoreKeyframeMask(const SequenceEntry& entry,
-                                                          const cv::Mat& mask) const {
+                                                          const cv::Mat& mask, bool keep) const {
   if (gt_masks_dir_.empty() || mask.empty()) return std::nullopt;
   const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
-  const cv::Mat gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  // Read when the keyframe is tracked, reused (then dropped) when it is mapped.
+  cv::Mat gt;
+  if (const auto it = truth_cache_.find(path); it != truth_cache_.end()) {
+    gt = it->second;
+    truth_cache_.erase(it);
+  } else {
+    gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (keep) truth_cache_[path] = gt;
+  }
   if (gt.empty() || gt.size() != mask.size()) return std::nullopt;  // no usable truth
   return scoreMask(mask, gt);
 }

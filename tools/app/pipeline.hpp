@@ -76,8 +76,9 @@ class Pipeline {
   /// After finish(): the masks the mapper revised replace the ones scored and written, and the
   /// map's mask scores are summed.
   void revisedKeyframeMasks(RunResult& result);
-  std::optional<MaskFrameScore> scoreKeyframeMask(const SequenceEntry& entry,
-                                                  const cv::Mat& mask) const;
+  /// `keep`: the truth read stays cached for the keyframe's next score (when it is mapped).
+  std::optional<MaskFrameScore> scoreKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
+                                                  bool keep = false) const;
   void writeKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
                          const cv::Size& size) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
@@ -95,6 +96,8 @@ class Pipeline {
   std::unordered_map<std::uint64_t, std::size_t> keyframe_entry_;  ///< keyframe id -> entry
   std::map<std::uint64_t, std::size_t> mapped_entry_;              ///< mapped keyframe id -> entry
   std::map<std::uint64_t, MaskFrameScore> mapped_scores_;          ///< the map's masks vs the truth
+  /// Ground-truth masks read for a keyframe's tracker score, kept for its map score (read once).
+  mutable std::unordered_map<std::string, cv::Mat> truth_cache_;
 };
 
 }  // namespace dynamap
