@@ -51,6 +51,12 @@ TEST(RunCommand, WritesEveryOutputOnARealSequence) {
   EXPECT_GT(finish_s, 0.0);
   EXPECT_LT(finish_s, wall_s);
   EXPECT_GE(number_at("frames_per_s_before_finish"), number_at("frames_per_s"));
+  // CPU time over the run: some was spent, and 2 threads at most per wall second would be 2x
+  // wall; the process has a handful of threads, so it stays below 8x (a loose sanity bound).
+  const double cpu_s = number_at("cpu_s");
+  EXPECT_GT(cpu_s, 0.0);
+  EXPECT_LT(cpu_s, 8.0 * wall_s);
+  EXPECT_NEAR(number_at("cpu_ms_per_frame"), 1000.0 * cpu_s / 40.0, 1e-3 * cpu_s);
   const std::string metrics = test::readFile((out / "metrics.json").string());
   EXPECT_NE(metrics.find("\"ate\""), std::string::npos);
   EXPECT_NE(metrics.find("\"rpe\""), std::string::npos);

@@ -1,6 +1,8 @@
 #include "pipeline.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -90,11 +92,23 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
 
 Pipeline::~Pipeline() = default;
 
+namespace {
+
+double processCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+}  // namespace
+
 RunResult Pipeline::run() {
   RunResult result;
   result.backend = config_.mapping.backend;
   result.mode = options_.realtime ? "realtime" : "offline";
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start_s = processCpuSeconds();
   try {
     processFrames(result);
   } catch (const std::exception& e) {
@@ -112,6 +126,7 @@ RunResult Pipeline::run() {
   const auto end = std::chrono::steady_clock::now();
   result.wall_time_s = std::chrono::duration<double>(end - start).count();
   result.finish_s = std::chrono::duration<double>(end - finish_start).count();
+  result.cpu_s = processCpuSeconds() - cpu_start_s;
   return result;
 }
 

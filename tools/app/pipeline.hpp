@@ -42,6 +42,9 @@ struct RunResult {
   std::vector<TimedPose> keyframes;
   double wall_time_s = 0.0;  ///< the whole run: the frames, then finishing
   double finish_s = 0.0;     ///< finishing: last bundle adjustment, mapper queue, visibility pass
+  /// CPU time of every thread over wall_time_s (user + system): steadier than the wall clock on
+  /// a shared machine, and what 2 cores must fit into.
+  double cpu_s = 0.0;
   std::string backend;
   std::string mode = "offline";  ///< offline | realtime
   std::string map_dir;

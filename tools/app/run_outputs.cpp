@@ -52,6 +52,11 @@ std::string timingsJson(const RunResult& result, const TimingRecorder& timings, 
                      {"frames_per_s", fps},
                      {"finish_s", result.finish_s},
                      {"frames_per_s_before_finish", loop_fps},
+                     {"cpu_s", result.cpu_s},
+                     {"cpu_ms_per_frame",
+                      result.counts.frames_read > 0
+                          ? 1000.0 * result.cpu_s / static_cast<double>(result.counts.frames_read)
+                          : 0.0},
                      {"tracking_median_ms", tracking.median_ms},
                      {"tracking_p95_ms", tracking.p95_ms},
                      {"peak_memory_mib", peakMemoryMiB()},
