@@ -137,5 +137,55 @@ TEST(FusionAnchors, APersonStandingStillSwaysACentimetreAndIsKept) {
   EXPECT_LT(px_only, 0.9) << px_only;
 }
 
+/// A person 2 m away, still for 20 frames (kept), then one frame in which every point on him is
+/// flagged and his points sit `shift_px` to the side. Returns that frame's result.
+FusionResult flaggedAfterStandingStill(float shift_px) {
+  const cv::Rect person(280, 120, 90, 260);
+  DynamicConfig c;
+  FusionEvidence ev;
+  ev.has_pose = true;
+  ev.K = kK;
+  RegionFusion fusion(c, ClassTable(c));
+  const Detection det{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
+  FusionResult r;
+  for (int i = 0; i <= 20; ++i) {
+    const float shift = i == 20 ? shift_px : 0.f;
+    std::vector<cv::Point2f> points;
+    std::vector<std::uint8_t> flags;
+    ev.point_ids.clear();
+    for (int y = 5; y < 480; y += 10) {
+      for (int x = 5; x < 640; x += 10) {
+        const bool on = person.contains({x, y});
+        points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
+        flags.push_back(on && i == 20 ? 1 : 0);
+        ev.point_ids.push_back(points.size() - 1);
+      }
+    }
+    ev.flags_valid = true;
+    cv::Mat depth(480, 640, CV_32F, cv::Scalar(5.f));
+    depth(person + cv::Point(cvRound(shift), 0)).setTo(2.f);
+    r = fusion.fuse(FusionMode::kBoth, depth, points, flags, {det}, ev);
+    if (i == 19) {
+      EXPECT_FALSE(r.objects.at(0).moving) << "kept before the flagged frame";
+    }
+  }
+  return r;
+}
+
+TEST(FusionAnchors, FlagsOnAPersonKeptStillThatHisAnchorsDoNotConfirmAreHeldNotEvidenced) {
+  // 5 px at 2 m: past the still limit (1.5 cm = 4.0 px) but within twice it: no verdict from
+  // the anchors. He is masked in this frame, as held (the map's hindsight may keep him).
+  const FusionResult unconfirmed = flaggedAfterStandingStill(5.f);
+  const cv::Point centre(330, 250);
+  EXPECT_TRUE(unconfirmed.objects.at(0).moving);
+  EXPECT_EQ(unconfirmed.mask.at<uchar>(centre), 255);
+  EXPECT_EQ(unconfirmed.held.at<uchar>(centre), 255);
+  // 12 px (4.5 cm): the anchors confirm it, he moved: masked and not held.
+  const FusionResult moved = flaggedAfterStandingStill(12.f);
+  EXPECT_TRUE(moved.objects.at(0).moving);
+  EXPECT_EQ(moved.mask.at<uchar>(centre), 255);
+  EXPECT_EQ(moved.held.at<uchar>(centre), 0);
+}
+
 }  // namespace
 }  // namespace dynamap

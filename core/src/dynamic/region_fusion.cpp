@@ -275,7 +275,12 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
       anchored ? anchor_still : (quiet && ev.background_fit) || (few_points && still);
   t.quiet_frames = d.moving_now ? 0 : before + (evidence_now ? 1 : 0);
   if (d.moving_now) t.has_anchor = false, t.anchors = d.anchor.fresh;
-  d.motion_now = flagged_now || anchor_moved || t.moving;
+  // A person confirmed still whose flags its anchors do not confirm (they drifted, but less than
+  // twice the pose noise) is masked now but held: hindsight may keep him in the map.
+  const bool confirmed_before =
+      prev != nullptr && !prev->moving && prev->quiet_frames >= config_.static_confirm_frames;
+  const bool unconfirmed_flags = confirmed_before && anchored && !anchor_moved;
+  d.motion_now = (flagged_now && !unconfirmed_flags) || anchor_moved || t.moving;
   if (classes_.isHighDynamic(d.detection.class_id)) {
     // Anchors off by more than the pose noise mask it in this frame (its count is kept).
     const int needed = config_.static_confirm_frames << std::min(t.slow_moves, kMaxSlowDoublings);
