@@ -94,32 +94,47 @@ TEST(FusionAnchors, APersonSwayingAlongTheLineOfSightIsRarelyKeptAStillOneIs) {
   EXPECT_GT(keptShare(c, 225, stand, true), 0.95);
 }
 
+/// A frame with a person 2 m away (kPerson) in front of a wall 5 m away: a point every 10 px,
+/// those on him shifted `shift` px sideways (and flagged with `flag_person`), ids in `ev`.
+const cv::Rect kPerson(280, 120, 90, 260);
+const Detection kPersonBox{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
+
+struct SidewaysFrame {
+  std::vector<cv::Point2f> points;
+  std::vector<std::uint8_t> flags;
+  cv::Mat depth;
+};
+
+SidewaysFrame sidewaysFrame(float shift, bool flag_person, FusionEvidence& ev) {
+  SidewaysFrame f;
+  ev.point_ids.clear();
+  for (int y = 5; y < 480; y += 10) {
+    for (int x = 5; x < 640; x += 10) {
+      const bool on = kPerson.contains({x, y});
+      f.points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
+      f.flags.push_back(on && flag_person ? 1 : 0);
+      ev.point_ids.push_back(f.points.size() - 1);
+    }
+  }
+  f.depth = cv::Mat(480, 640, CV_32F, cv::Scalar(5.f));
+  f.depth(kPerson + cv::Point(cvRound(shift), 0)).setTo(2.f);
+  return f;
+}
+
 /// Share of `frames` frames in which a person 2 m away, never flagged, whose image shifts
 /// sideways by dx(i) pixels (its tracked points with it), is kept.
 template <typename ShiftOf>
 double keptShareSideways(const DynamicConfig& c, int frames, ShiftOf dx) {
-  const cv::Rect person(280, 120, 90, 260);
   FusionEvidence ev;
   ev.has_pose = true;
   ev.K = kK;
   RegionFusion fusion(c, ClassTable(c));
-  const Detection det{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
   int kept = 0;
   for (int i = 0; i < frames; ++i) {
-    const float shift = static_cast<float>(dx(i));
-    std::vector<cv::Point2f> points;
-    ev.point_ids.clear();
-    for (int y = 5; y < 480; y += 10) {
-      for (int x = 5; x < 640; x += 10) {
-        const bool on = person.contains({x, y});
-        points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
-        ev.point_ids.push_back(points.size() - 1);
-      }
-    }
-    const std::vector<std::uint8_t> quiet(points.size(), 0);
-    cv::Mat depth(480, 640, CV_32F, cv::Scalar(5.f));
-    depth(person + cv::Point(cvRound(shift), 0)).setTo(2.f);
-    kept += !fusion.fuse(FusionMode::kBoth, depth, points, quiet, {det}, ev).objects.at(0).moving;
+    const SidewaysFrame f = sidewaysFrame(static_cast<float>(dx(i)), false, ev);
+    kept += !fusion.fuse(FusionMode::kBoth, f.depth, f.points, f.flags, {kPersonBox}, ev)
+                 .objects.at(0)
+                 .moving;
   }
   return kept / static_cast<double>(frames);
 }
@@ -140,31 +155,16 @@ TEST(FusionAnchors, APersonStandingStillSwaysACentimetreAndIsKept) {
 /// A person 2 m away, still for 20 frames (kept), then one frame in which every point on him is
 /// flagged and his points sit `shift_px` to the side. Returns that frame's result.
 FusionResult flaggedAfterStandingStill(float shift_px) {
-  const cv::Rect person(280, 120, 90, 260);
   DynamicConfig c;
   FusionEvidence ev;
   ev.has_pose = true;
   ev.K = kK;
+  ev.flags_valid = true;
   RegionFusion fusion(c, ClassTable(c));
-  const Detection det{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
   FusionResult r;
   for (int i = 0; i <= 20; ++i) {
-    const float shift = i == 20 ? shift_px : 0.f;
-    std::vector<cv::Point2f> points;
-    std::vector<std::uint8_t> flags;
-    ev.point_ids.clear();
-    for (int y = 5; y < 480; y += 10) {
-      for (int x = 5; x < 640; x += 10) {
-        const bool on = person.contains({x, y});
-        points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
-        flags.push_back(on && i == 20 ? 1 : 0);
-        ev.point_ids.push_back(points.size() - 1);
-      }
-    }
-    ev.flags_valid = true;
-    cv::Mat depth(480, 640, CV_32F, cv::Scalar(5.f));
-    depth(person + cv::Point(cvRound(shift), 0)).setTo(2.f);
-    r = fusion.fuse(FusionMode::kBoth, depth, points, flags, {det}, ev);
+    const SidewaysFrame f = sidewaysFrame(i == 20 ? shift_px : 0.f, i == 20, ev);
+    r = fusion.fuse(FusionMode::kBoth, f.depth, f.points, f.flags, {kPersonBox}, ev);
     if (i == 19) {
       EXPECT_FALSE(r.objects.at(0).moving) << "kept before the flagged frame";
     }

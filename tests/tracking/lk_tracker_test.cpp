@@ -1,3 +1,5 @@
+#include <cstdint>
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -8,16 +10,28 @@
 namespace dynamap {
 namespace {
 
-TEST(LkTracker, TracksKnownSubPixelShift) {
+/// A textured plane seen by the freiburg3 camera (`seed` picks the texture) and the same image
+/// shifted by `shift` pixels.
+struct ShiftedPair {
+  cv::Mat gray, shifted;
+};
+
+ShiftedPair texturedPlaneShifted(std::uint64_t seed, const cv::Point2f& shift) {
   const PinholeCamera camera = cameraPreset("freiburg3");
-  test::SyntheticScene scene(camera, 5);
+  test::SyntheticScene scene(camera, seed);
   scene.addPlane({-2.0, -1.5, 1.5}, {4.0, 0, 0}, {0, 3.0, 0});
   const auto frame = scene.render(Eigen::Isometry3d::Identity(), 0.0);
-  cv::Mat gray, shifted;
-  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-  const cv::Point2f shift(7.35f, -4.6f);
+  ShiftedPair pair;
+  cv::cvtColor(frame.bgr, pair.gray, cv::COLOR_BGR2GRAY);
   const cv::Matx23d M(1, 0, shift.x, 0, 1, shift.y);
-  cv::warpAffine(gray, shifted, M, gray.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  cv::warpAffine(pair.gray, pair.shifted, M, pair.gray.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  return pair;
+}
+
+TEST(LkTracker, TracksKnownSubPixelShift) {
+  const cv::Point2f shift(7.35f, -4.6f);
+  const ShiftedPair pair = texturedPlaneShifted(5, shift);
+  const cv::Mat &gray = pair.gray, &shifted = pair.shifted;
 
   std::vector<cv::Point2f> prev_px;
   cv::goodFeaturesToTrack(gray, prev_px, 300, 0.01, 15);
@@ -56,14 +70,8 @@ TEST(LkTracker, ForwardBackwardCheckRejectsUntrackablePoints) {
 }
 
 TEST(LkTracker, TwoThreadsTrackEveryPointAsOneDoes) {
-  const PinholeCamera camera = cameraPreset("freiburg3");
-  test::SyntheticScene scene(camera, 7);
-  scene.addPlane({-2.0, -1.5, 1.5}, {4.0, 0, 0}, {0, 3.0, 0});
-  const auto frame = scene.render(Eigen::Isometry3d::Identity(), 0.0);
-  cv::Mat gray, moved;
-  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-  const cv::Matx23d M(1, 0, 3.2, 0, 1, 1.7);
-  cv::warpAffine(gray, moved, M, gray.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+  const ShiftedPair pair = texturedPlaneShifted(7, {3.2f, 1.7f});
+  const cv::Mat &gray = pair.gray, &moved = pair.shifted;
   std::vector<cv::Point2f> prev_px;
   cv::goodFeaturesToTrack(gray, prev_px, 400, 0.01, 8);
   ASSERT_GT(prev_px.size(), 200u);

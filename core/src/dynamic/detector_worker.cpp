@@ -38,6 +38,14 @@ bool DetectorWorker::beganPending() const {
                      [](const Job& j) { return j.frame_no != kReadAhead; });
 }
 
+bool DetectorWorker::readAheadPending() const {
+  return (busy_ && flight_frame_ == kReadAhead && !flight_dropped_) ||
+         std::any_of(jobs_.begin(), jobs_.end(),
+                     [](const Job& j) { return j.frame_no == kReadAhead; }) ||
+         std::any_of(done_.begin(), done_.end(),
+                     [](const Done& d) { return d.result.frame_no == kReadAhead; });
+}
+
 // The frame read ahead becomes frame `frame_no` if it has this timestamp; any other frame read
 // ahead was never begun and is dropped.
 bool DetectorWorker::adoptReadAhead(long frame_no, double stamp) {
@@ -84,13 +92,8 @@ bool DetectorWorker::submit(const cv::Mat& bgr, long frame_no, double stamp, boo
 
 void DetectorWorker::prefetch(const cv::Mat& bgr, double stamp) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool pending = (busy_ && flight_frame_ == kReadAhead && !flight_dropped_) ||
-                       std::any_of(jobs_.begin(), jobs_.end(),
-                                   [](const Job& j) { return j.frame_no == kReadAhead; }) ||
-                       std::any_of(done_.begin(), done_.end(),
-                                   [](const Done& d) { return d.result.frame_no == kReadAhead; });
   // A frame already begun (its read-ahead came late) is not detected twice.
-  if (pending || stop_ || (begun_any_ && stamp <= last_begun_stamp_)) return;
+  if (readAheadPending() || stop_ || (begun_any_ && stamp <= last_begun_stamp_)) return;
   jobs_.push_back({bgr.clone(), kReadAhead, stamp});
   cv_.notify_all();
 }

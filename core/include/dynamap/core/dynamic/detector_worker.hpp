@@ -64,7 +64,8 @@ class DetectorWorker {
     Result result;
     std::exception_ptr error;
   };
-  bool beganPending() const;  ///< a begun frame is queued or in flight
+  bool beganPending() const;      ///< a begun frame is queued or in flight
+  bool readAheadPending() const;  ///< a frame read ahead is queued, in flight or done
   bool adoptReadAhead(long frame_no, double stamp);
   void loop();
 
