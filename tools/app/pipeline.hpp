@@ -74,14 +74,13 @@ class Pipeline {
   void processFrames(RunResult& result);
   void processFrame(std::size_t index, const FrameLoad& load, RunResult& result);
   void finalize(RunResult& result);
-  /// Scores (and with --save-masks writes) the masks of keyframes handed to the mapper.
+  /// Keeps (and with --save-masks writes) the masks of keyframes handed to the mapper.
   void mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped);
-  /// After finish(): the masks the mapper revised replace the ones scored and written, and the
-  /// map's mask scores are summed.
-  void revisedKeyframeMasks(RunResult& result);
-  /// `keep`: the truth read stays cached for the keyframe's next score (when it is mapped).
-  std::optional<MaskFrameScore> scoreKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
-                                                  bool keep = false) const;
+  /// After finish(): the masks the mapper revised replace the ones kept and written.
+  void revisedKeyframeMasks();
+  /// After the timed run: the kept keyframe masks against the sequence's ground-truth masks
+  /// (evaluation, not the system's work: it does not count in the run's time).
+  void scoreKeyframeMasks(RunResult& result) const;
   void writeKeyframeMask(const SequenceEntry& entry, const cv::Mat& mask,
                          const cv::Size& size) const;
   void writeDebugImage(const SequenceEntry& entry, const RgbdFrame& frame,
@@ -98,9 +97,14 @@ class Pipeline {
   bool object_log_started_ = false;
   std::unordered_map<std::uint64_t, std::size_t> keyframe_entry_;  ///< keyframe id -> entry
   std::map<std::uint64_t, std::size_t> mapped_entry_;              ///< mapped keyframe id -> entry
-  std::map<std::uint64_t, MaskFrameScore> mapped_scores_;          ///< the map's masks vs the truth
-  /// Ground-truth masks read for a keyframe's tracker score, kept for its map score (read once).
-  mutable std::unordered_map<std::string, cv::Mat> truth_cache_;
+  /// With ground-truth masks: each keyframe's mask as the tracker made it (entry, mask), in
+  /// keyframe order, and as the map used it (by keyframe id).
+  struct KeptMask {
+    std::size_t entry = 0;
+    cv::Mat mask;
+  };
+  std::vector<KeptMask> tracker_masks_;
+  std::map<std::uint64_t, KeptMask> mapped_masks_;
 };
 
 }  // namespace dynamap

@@ -142,20 +142,12 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
   if (cut) {
     // Not the object's: its pixels on a support plane, and, farther than max_depth_m, where the
     // object would be larger than it can be: that surface is behind it (the wall beside a
-    // walker cut by the border, a box left on the wall). Depth compared as float, as cv::compare
-    // does with a scalar.
-    const cv::Mat not_in_box = not_object.empty() ? cv::Mat() : not_object(box);
-    const auto far = static_cast<float>(max_depth_m);
-    cv::Mat cut_z(box.size(), CV_32FC1);
-    for (int y = 0; y < box.height; ++y) {
-      const float* in = z.ptr<float>(y);
-      const uchar* no = not_in_box.empty() ? nullptr : not_in_box.ptr<uchar>(y);
-      float* out = cut_z.ptr<float>(y);
-      for (int x = 0; x < box.width; ++x) {
-        const bool drop = (no != nullptr && no[x] != 0) || (max_depth_m > 0.0 && in[x] > far);
-        out[x] = drop ? 0.f : in[x];
-      }
-    }
+    // walker cut by the border, a box left on the wall). Depth compared as float (cv::compare
+    // with a scalar; vectorised, where a loop mixing mask bytes and depth floats was not).
+    cv::Mat cut_z;
+    z.copyTo(cut_z);
+    if (max_depth_m > 0.0) cut_z.setTo(0.f, z > static_cast<float>(max_depth_m));
+    if (!not_object.empty()) cut_z.setTo(0.f, not_object(box));
     z = cut_z;
   }
   double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
@@ -170,28 +162,28 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
     return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
   }
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
-  cv::Mat sel(box.size(), CV_8UC1);
   const auto lo = static_cast<float>(mode - band_m), hi = static_cast<float>(mode + band_m);
-  for (int y = 0; y < box.height; ++y) {
-    const float* row = z.ptr<float>(y);
-    uchar* out = sel.ptr<uchar>(y);
-    for (int x = 0; x < box.width; ++x) out[x] = row[x] > lo && row[x] < hi ? 255 : 0;
-  }
+  cv::Mat sel = (z > lo) & (z < hi);  // compared as float
   cv::morphologyEx(sel, sel, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
   if (!not_object.empty()) sel.setTo(0, not_object(box));
   cv::Mat labels;
   const int n = cv::connectedComponents(sel, labels, 8, CV_32S);
   std::vector<int> votes(n, 0);
-  for (int y = inner.y; y < inner.br().y; ++y) {
-    for (int x = inner.x; x < inner.br().x; ++x) ++votes[labels.at<int>(y, x)];
+  for (int y = inner.y; y < inner.br().y; ++y) {  // a row's labels come in runs
+    const int* label = labels.ptr<int>(y);
+    for (int x = inner.x; x < inner.br().x;) {
+      const int l = label[x];
+      const int start = x;
+      while (x < inner.br().x && label[x] == l) ++x;
+      votes[l] += x - start;
+    }
   }
   votes[0] = 0;
   const int best = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
   cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
-  for (int y = 0; y < box.height && best > 0; ++y) {
-    const int* label = labels.ptr<int>(y);
-    uchar* row = out.ptr<uchar>(box.y + y) + box.x;
-    for (int x = 0; x < box.width; ++x) row[x] = label[x] == best ? 255 : 0;
+  if (best > 0) {
+    cv::Mat in_box = out(box);
+    cv::compare(labels, best, in_box, cv::CMP_EQ);
   }
   return out;
 }
