@@ -3,6 +3,7 @@
 // readers, and following pose updates.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -53,6 +54,36 @@ std::size_t countInsideMoving(const std::vector<Eigen::Vector3f>& pts, double ma
   return n;
 }
 
+/// The text OBJ holds the binary PLY's mesh, each number as printf's "%.5f" (position) and
+/// "%.4f" (colour / 255) write it, faces 1-based.
+void expectObjMatchesPly(const fs::path& dir) {
+  const PlyData mesh = readPly((dir / "mesh.ply").string(), true);
+  std::ifstream obj(dir / "mesh.obj");
+  std::string line;
+  std::size_t v = 0, f = 0;
+  char want[256];
+  while (std::getline(obj, line)) {
+    if (line.rfind("v ", 0) == 0) {
+      ASSERT_LT(v, mesh.vertices.size());
+      const auto& p = mesh.vertices[v];
+      const auto& c = mesh.colors[v];
+      std::snprintf(want, sizeof(want), "v %.5f %.5f %.5f %.4f %.4f %.4f", p.x(), p.y(), p.z(),
+                    c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
+      ASSERT_EQ(line, want) << "vertex " << v;
+      ++v;
+    } else if (line.rfind("f ", 0) == 0) {
+      ASSERT_LT(f, mesh.triangles.size());
+      const auto& t = mesh.triangles[f];
+      std::snprintf(want, sizeof(want), "f %u %u %u", t[0] + 1, t[1] + 1, t[2] + 1);
+      ASSERT_EQ(line, want) << "face " << f;
+      ++f;
+    }
+  }
+  EXPECT_EQ(v, mesh.vertices.size());
+  EXPECT_EQ(f, mesh.triangles.size());
+  EXPECT_GT(f, 0u);
+}
+
 void expectExportsLoad(const std::string& name, const fs::path& dir) {
   const std::map<std::string, std::vector<std::string>> expected = {
       {"points", {"cloud.ply", "cloud.pcd"}},
@@ -63,6 +94,7 @@ void expectExportsLoad(const std::string& name, const fs::path& dir) {
   if (expected.count(name)) {
     for (const auto& f : expected.at(name)) EXPECT_TRUE(fs::exists(dir / f)) << f;
   }
+  if (fs::exists(dir / "mesh.obj") && fs::exists(dir / "mesh.ply")) expectObjMatchesPly(dir);
   for (const auto& e : fs::directory_iterator(dir)) {  // no temporary left behind
     EXPECT_NE(e.path().filename().string().front(), '.') << e.path();
   }

@@ -91,5 +91,41 @@ TEST(LkTracker, TwoThreadsTrackEveryPointAsOneDoes) {
   }
 }
 
+// The backward (consistency) pass starts from the point's own position, so a few levels do: the
+// forward answers stay bit for bit, a shift too large for 3 levels (41 px) still passes, and an
+// untrackable point fails.
+TEST(LkTracker, BackwardPassOverFewLevelsKeepsTheForwardAnswerAndTheCheck) {
+  const ShiftedPair pair = texturedPlaneShifted(11, {41.3f, -22.7f});
+  std::vector<cv::Point2f> prev_px;
+  cv::goodFeaturesToTrack(pair.gray, prev_px, 300, 0.01, 12);
+  std::vector<cv::Point2f> inner;
+  for (const auto& p : prev_px) {
+    if (p.x > 60 && p.y > 60 && p.x < pair.gray.cols - 60 && p.y < pair.gray.rows - 60)
+      inner.push_back(p);
+  }
+  ASSERT_GT(inner.size(), 100u);
+  inner.push_back({320.f, 240.f});  // the last point lies on a blank patch (below)
+  cv::Mat gray = pair.gray.clone(), moved = pair.shifted.clone();
+  gray(cv::Rect(290, 210, 60, 60)).setTo(128);
+  moved(cv::Rect(290, 210, 60, 60)).setTo(128);
+
+  const TrackerConfig config;
+  const LkTracker lk(config);
+  const LkPyramid a = lk.buildPyramid(gray), b = lk.buildPyramid(moved);
+  std::vector<cv::Point2f> px_all = inner, px_few = inner;
+  std::vector<std::uint8_t> ok_all, ok_few;
+  lk.track(a, b, inner, px_all, ok_all);
+  lk.track(a, b, inner, px_few, ok_few, 3);
+  int agree = 0, passed = 0;
+  for (std::size_t i = 0; i < inner.size(); ++i) {
+    EXPECT_EQ(px_few[i], px_all[i]) << i;  // the forward pass is the same
+    agree += ok_few[i] == ok_all[i];
+    passed += ok_few[i];
+  }
+  EXPECT_GE(agree, static_cast<int>(0.97 * inner.size()));
+  EXPECT_GE(passed, static_cast<int>(0.9 * (inner.size() - 1)));
+  EXPECT_EQ(ok_few.back(), 0);  // blank: no consistent track
+}
+
 }  // namespace
 }  // namespace dynamap

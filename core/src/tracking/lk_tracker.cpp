@@ -22,26 +22,27 @@ LkPyramid LkTracker::buildPyramid(const cv::Mat& gray) const {
 
 void LkTracker::track(const LkPyramid& prev, const LkPyramid& cur,
                       const std::vector<cv::Point2f>& prev_px, std::vector<cv::Point2f>& cur_px,
-                      std::vector<std::uint8_t>& ok) const {
+                      std::vector<std::uint8_t>& ok, int backward_levels) const {
   ok.assign(prev_px.size(), 0);
+  const int back = backward_levels > 0 ? std::min(max_level_, backward_levels - 1) : max_level_;
   if (prev_px.empty() || prev.empty() || cur.empty()) return;
   // Each point is tracked on its own, so the points split over threads give the same result.
   const std::size_t n = prev_px.size();
   if (threads_ < 2 || n < kMinPointsPerThread * 2) {
-    trackRange(prev, cur, prev_px, cur_px, ok, 0, n);
+    trackRange(prev, cur, prev_px, cur_px, ok, back, 0, n);
     return;
   }
   const std::size_t half = n / 2;
-  auto first =
-      std::async(std::launch::async, [&] { trackRange(prev, cur, prev_px, cur_px, ok, 0, half); });
-  trackRange(prev, cur, prev_px, cur_px, ok, half, n);
+  auto first = std::async(std::launch::async,
+                          [&] { trackRange(prev, cur, prev_px, cur_px, ok, back, 0, half); });
+  trackRange(prev, cur, prev_px, cur_px, ok, back, half, n);
   first.get();
 }
 
 void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
                            const std::vector<cv::Point2f>& all_prev_px,
                            std::vector<cv::Point2f>& all_cur_px, std::vector<std::uint8_t>& all_ok,
-                           std::size_t begin, std::size_t end) const {
+                           int backward_max_level, std::size_t begin, std::size_t end) const {
   const auto b = static_cast<std::ptrdiff_t>(begin), e = static_cast<std::ptrdiff_t>(end);
   const std::vector<cv::Point2f> prev_px(all_prev_px.begin() + b, all_prev_px.begin() + e);
   std::vector<cv::Point2f> cur_px(all_cur_px.begin() + b, all_cur_px.begin() + e);
@@ -52,7 +53,7 @@ void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
   cv::calcOpticalFlowPyrLK(prev, cur, prev_px, cur_px, fwd_status, err, window_, max_level_,
                            criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
   std::vector<cv::Point2f> back_px = prev_px;
-  cv::calcOpticalFlowPyrLK(cur, prev, cur_px, back_px, bwd_status, err, window_, max_level_,
+  cv::calcOpticalFlowPyrLK(cur, prev, cur_px, back_px, bwd_status, err, window_, backward_max_level,
                            criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
   const cv::Size size = cur.front().size();
   const double fb2 = fb_threshold_px_ * fb_threshold_px_;

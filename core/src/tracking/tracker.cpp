@@ -216,7 +216,7 @@ void Tracker::Impl::trackProbes(const LkPyramid& cur, FeatureMatches& matches) {
   std::vector<cv::Point2f> cur_px(probes_.size());
   for (std::size_t i = 0; i < probes_.size(); ++i) cur_px[i] = probes_[i] + flow;
   std::vector<std::uint8_t> ok;
-  lk_.track(prev_pyramid_, cur, probes_, cur_px, ok);
+  lk_.track(prev_pyramid_, cur, probes_, cur_px, ok, config_.motion_probe_backward_levels);
   std::vector<cv::Point2f> kept;
   std::vector<std::uint64_t> kept_ids;
   kept.reserve(probes_.size());

@@ -30,6 +30,9 @@ struct TrackerConfig {
   /// are dropped, and a mover without tracks gets no mask). 0 = landmark tracks only.
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
+  /// Pyramid levels of the probes' backward (consistency) pass, which starts from the probe's
+  /// own position (0 = lk_levels, as the landmark tracks).
+  int motion_probe_backward_levels = 0;
 
   /// With a motion filter: the camera motion handed to it is first estimated against the
   /// tracked landmarks that at least this many keyframes observed (those proven static over
