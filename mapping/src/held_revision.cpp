@@ -4,8 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
+#include <vector>
 
+#include "dynamap/mapping/flat_index.hpp"
 #include "in_two.hpp"
 #include "visibility_table.hpp"
 
@@ -41,7 +42,24 @@ struct VoxelVotes {
   }
 };
 
-using Votes = std::unordered_map<std::uint64_t, VoxelVotes>;
+/// The votes by voxel key (a flat index into one array: the look-ups below, 27 per distinct
+/// voxel of a held region, cost a third of what std::unordered_map's do).
+class Votes {
+ public:
+  VoxelVotes& at(std::uint64_t key) {
+    const auto [i, inserted] = index_.tryEmplace(key, static_cast<std::uint32_t>(votes_.size()));
+    if (inserted) votes_.emplace_back();
+    return votes_[i];
+  }
+  const VoxelVotes* find(std::uint64_t key) const {
+    const std::uint32_t i = index_.find(key);
+    return i == FlatIndex::kMissing ? nullptr : &votes_[i];
+  }
+
+ private:
+  FlatIndex index_;
+  std::vector<VoxelVotes> votes_;
+};
 
 /// Keyframe k's held pixels whose voxel (26 neighbours included) at least `min_keyframes` other
 /// keyframes confirmed static, and more than saw motion there; empty if none.
@@ -66,10 +84,10 @@ cv::Mat confirmedHeldPixels(const PinholeCamera& camera, const HeldKeyframe& kf,
         for (int dz = -1; dz <= 1; ++dz) {
           for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
-              const auto it = votes.find(vis::offsetKey(at, dx, dy, dz));
-              if (it == votes.end()) continue;
-              confirmed = std::max(confirmed, it->second.confirmedByOthers(k));
-              moved = std::max(moved, it->second.moved);
+              const VoxelVotes* near = votes.find(vis::offsetKey(at, dx, dy, dz));
+              if (near == nullptr) continue;
+              confirmed = std::max(confirmed, near->confirmedByOthers(k));
+              moved = std::max(moved, near->moved);
             }
           }
         }
@@ -116,13 +134,13 @@ std::vector<cv::Mat> heldConfirmedElsewhere(const PinholeCamera& camera,
     bool have_last = false;
     for (const Eigen::Vector3f& p_C : keyframes[k].confirmed_C) {
       const std::uint64_t at = key(keyframes[k].T_W_C * p_C.cast<double>());
-      if (!have_last || at != last) votes[at].confirm(static_cast<int>(k));
+      if (!have_last || at != last) votes.at(at).confirm(static_cast<int>(k));
       last = at, have_last = true, any_confirmed = true;
     }
     have_last = false;
     for (const Eigen::Vector3f& p_C : keyframes[k].moved_C) {
       const std::uint64_t at = key(keyframes[k].T_W_C * p_C.cast<double>());
-      if (!have_last || at != last) votes[at].move(static_cast<int>(k));
+      if (!have_last || at != last) votes.at(at).move(static_cast<int>(k));
       last = at, have_last = true;
     }
   }

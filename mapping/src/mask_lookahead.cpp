@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/core/rounding.hpp"
+
 namespace dynamap {
 namespace {
 constexpr double kMaxMoveM = 0.3;    ///< 9 m/s at 30 frames/s over one frame
@@ -49,8 +51,8 @@ cv::Mat maskSeenLater(const PinholeCamera& camera, const cv::Mat& depth_m,
       const Eigen::Vector3f p =
           R * Eigen::Vector3f(x_n[static_cast<std::size_t>(u)] * z, y_n * z, z) + t;
       if (p.z() <= 0.1f) continue;
-      const int ul = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
-      const int vl = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
+      const int ul = static_cast<int>(roundHalfAway(fx * p.x() / p.z() + cx));
+      const int vl = static_cast<int>(roundHalfAway(fy * p.y() / p.z() + cy));
       if (ul < 0 || vl < 0 || ul >= w || vl >= h) continue;
       if (later_mask.at<std::uint8_t>(vl, ul) == 0) continue;
       const float seen = later_depth_m.at<float>(vl, ul);

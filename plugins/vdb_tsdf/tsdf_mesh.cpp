@@ -4,6 +4,7 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "tsdf_volume.hpp"
+#include "dynamap/core/rounding.hpp"
 
 namespace dynamap::plugin {
 namespace {
@@ -62,7 +63,7 @@ PlyData TsdfVolume::extractMesh(const openvdb::FloatGrid& voted) const {
         mesh.vertices.emplace_back(p.x(), p.y(), p.z());
         const openvdb::Vec3s q = p * inv_voxel;
         const openvdb::Vec3s c = colors.getValue(openvdb::Coord(
-            int(std::lround(q.x())), int(std::lround(q.y())), int(std::lround(q.z()))));
+            int(roundHalfAway(q.x())), int(roundHalfAway(q.y())), int(roundHalfAway(q.z()))));
         mesh.colors.push_back({static_cast<std::uint8_t>(std::clamp(c.x(), 0.0f, 255.0f)),
                                static_cast<std::uint8_t>(std::clamp(c.y(), 0.0f, 255.0f)),
                                static_cast<std::uint8_t>(std::clamp(c.z(), 0.0f, 255.0f))});

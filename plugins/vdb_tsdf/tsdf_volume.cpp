@@ -10,6 +10,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include "dynamap/core/rounding.hpp"
+#include "dynamap/mapping/radix_sort.hpp"
+
 namespace dynamap::plugin {
 namespace {
 
@@ -33,7 +36,7 @@ openvdb::Coord unpackLeaf(Key k) {
 // Origin of the leaf holding world point p.
 openvdb::Coord leafOf(const Eigen::Vector3d& p_W, double inv_voxel) {
   const auto idx = [&](double v) {
-    const int i = static_cast<int>(std::lround(v * inv_voxel));
+    const int i = static_cast<int>(roundHalfAway(v * inv_voxel));
     return i & ~(kLeafDim - 1);
   };
   return openvdb::Coord(idx(p_W.x()), idx(p_W.y()), idx(p_W.z()));
@@ -121,9 +124,9 @@ std::vector<openvdb::Coord> TsdfVolume::collectBlocks(const PinholeCamera& camer
       }
     }
   });
-  std::vector<Key> all;
+  std::vector<Key> all, scratch;
   keys.combine_each([&](const std::vector<Key>& v) { all.insert(all.end(), v.begin(), v.end()); });
-  std::sort(all.begin(), all.end());
+  radixSortByKey(all, scratch, [](Key k) { return k; });
   all.erase(std::unique(all.begin(), all.end()), all.end());
   std::vector<openvdb::Coord> blocks;
   blocks.reserve(all.size());
