@@ -1,10 +1,15 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
-#include <unordered_map>
+#include <cstdint>
+#include <vector>
 
 #include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
-#include "tsdf_volume.hpp"
 #include "dynamap/core/rounding.hpp"
+#include "tsdf_volume.hpp"
 
 namespace dynamap::plugin {
 namespace {
@@ -34,12 +39,25 @@ PlyData TsdfVolume::extractMesh(const openvdb::FloatGrid& voted) const {
   std::vector<openvdb::Vec4I> quads;
   openvdb::tools::volumeToMesh(voted, points, triangles, quads, 0.0, 0.0);
 
+  // Per vertex, on TBB's threads (each with its own accessors): whether its cell was observed,
+  // and its colour. Then faces and vertices in their order, on this thread.
   const float inv_voxel = static_cast<float>(1.0 / options_.voxel_size_m);
-  auto weights = weight_->getConstAccessor();
   std::vector<char> keep_vertex(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    keep_vertex[i] = cellObserved(weights, points[i] * inv_voxel, options_.min_weight) ? 1 : 0;
-  }
+  std::vector<std::array<std::uint8_t, 3>> vertex_colors(points.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 4096), [&](const auto& r) {
+    auto weights = weight_->getConstAccessor();
+    auto colors = color_->getConstAccessor();
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const openvdb::Vec3s q = points[i] * inv_voxel;
+      keep_vertex[i] = cellObserved(weights, q, options_.min_weight) ? 1 : 0;
+      if (!keep_vertex[i]) continue;
+      const openvdb::Vec3s c = colors.getValue(openvdb::Coord(
+          int(roundHalfAway(q.x())), int(roundHalfAway(q.y())), int(roundHalfAway(q.z()))));
+      vertex_colors[i] = {static_cast<std::uint8_t>(std::clamp(c.x(), 0.0f, 255.0f)),
+                          static_cast<std::uint8_t>(std::clamp(c.y(), 0.0f, 255.0f)),
+                          static_cast<std::uint8_t>(std::clamp(c.z(), 0.0f, 255.0f))};
+    }
+  });
   std::vector<std::array<std::uint32_t, 3>> faces;
   faces.reserve(triangles.size() + 2 * quads.size());
   auto addTriangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
@@ -54,19 +72,13 @@ PlyData TsdfVolume::extractMesh(const openvdb::FloatGrid& voted) const {
 
   PlyData mesh;
   std::vector<std::int64_t> remap(points.size(), -1);
-  auto colors = color_->getConstAccessor();
   for (auto& f : faces) {
     for (auto& idx : f) {
       if (remap[idx] < 0) {
         remap[idx] = static_cast<std::int64_t>(mesh.vertices.size());
         const openvdb::Vec3s& p = points[idx];
         mesh.vertices.emplace_back(p.x(), p.y(), p.z());
-        const openvdb::Vec3s q = p * inv_voxel;
-        const openvdb::Vec3s c = colors.getValue(openvdb::Coord(
-            int(roundHalfAway(q.x())), int(roundHalfAway(q.y())), int(roundHalfAway(q.z()))));
-        mesh.colors.push_back({static_cast<std::uint8_t>(std::clamp(c.x(), 0.0f, 255.0f)),
-                               static_cast<std::uint8_t>(std::clamp(c.y(), 0.0f, 255.0f)),
-                               static_cast<std::uint8_t>(std::clamp(c.z(), 0.0f, 255.0f))});
+        mesh.colors.push_back(vertex_colors[idx]);
       }
       idx = static_cast<std::uint32_t>(remap[idx]);
     }

@@ -118,29 +118,42 @@ class VdbTsdfBackend final : public MapBackend {
     namespace fs = std::filesystem;
     fs::create_directories(dir);
     const openvdb::FloatGrid::ConstPtr voted = volume_.votedTsdf();
-    const PlyData mesh = volume_.extractMesh(*voted);
     const fs::path d(dir);
-    // The text OBJ takes longest to write: on a thread of its own while the others are written.
-    std::exception_ptr obj_error;
-    std::thread obj([&] {
-      try {
-        writeAtomically((d / "mesh.obj").string(),
-                        [&](const std::string& tmp) { writeObj(tmp, mesh); });
-      } catch (...) {
-        obj_error = std::current_exception();
-      }
-    });
-    try {
-      writeAtomically((d / "mesh.ply").string(),
-                      [&](const std::string& tmp) { writePly(tmp, mesh); });
+    // The grids' file needs no mesh: it is written on a thread of its own while the mesh is made
+    // (reading the same grids) and written, the text OBJ on a third.
+    const auto on_thread = [](std::exception_ptr& error, auto write) {
+      return std::thread([&error, write] {
+        try {
+          write();
+        } catch (...) {
+          error = std::current_exception();
+        }
+      });
+    };
+    std::exception_ptr vdb_error, obj_error;
+    std::thread vdb = on_thread(vdb_error, [&] {
       writeAtomically((d / "tsdf.vdb").string(),
                       [&](const std::string& tmp) { volume_.writeVdb(tmp, voted); });
-    } catch (...) {
+    });
+    PlyData mesh;  // outlives every thread that reads it, also when a write throws
+    std::thread obj;
+    try {
+      mesh = volume_.extractMesh(*voted);
+      obj = on_thread(obj_error, [&] {
+        writeAtomically((d / "mesh.obj").string(),
+                        [&](const std::string& tmp) { writeObj(tmp, mesh); });
+      });
+      writeAtomically((d / "mesh.ply").string(),
+                      [&](const std::string& tmp) { writePly(tmp, mesh); });
       obj.join();
+    } catch (...) {
+      if (obj.joinable()) obj.join();
+      vdb.join();
       throw;
     }
-    obj.join();
+    vdb.join();
     if (obj_error) std::rethrow_exception(obj_error);
+    if (vdb_error) std::rethrow_exception(vdb_error);
   }
 
   MapStats stats() const override {

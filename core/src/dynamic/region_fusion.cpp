@@ -27,17 +27,21 @@ constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelP
 constexpr int kInPlaceMinSamples = 20;  ///< depth samples needed to call a cluster in place
 
 /// Dominant depth (m) of the valid pixels of `roi`, 0 if there are too few. With `near_m` > 0
-/// only depths within kContinuityM of it compete (the object was there a frame ago).
+/// only depths within kContinuityM of it compete (the object was there a frame ago). `dropped`
+/// (8-bit, roi's size, or empty): pixels read as 0, not the object's.
 constexpr double kContinuityM = 0.5;
-double depthMode(const cv::Mat& roi, double near_m) {
+double depthMode(const cv::Mat& roi, double near_m, const cv::Mat& dropped = cv::Mat()) {
+  const auto value = [&](int y, int x) {
+    return !dropped.empty() && dropped.at<uchar>(y, x) != 0 ? 0.f : roi.at<float>(y, x);
+  };
   std::vector<int> hist(kBins + 2, 0);
   int total = 0;
   for (int y = 0; y < roi.rows; y += 2) {
-    const float* row = roi.ptr<float>(y);
     for (int x = 0; x < roi.cols; x += 2) {
-      const int b = static_cast<int>(row[x] / kBinM);
-      const bool near = near_m <= 0.0 || std::abs(row[x] - near_m) < kContinuityM;
-      if (row[x] > 0.f && b < kBins && near) {
+      const float z = value(y, x);
+      const int b = static_cast<int>(z / kBinM);
+      const bool near = near_m <= 0.0 || std::abs(z - near_m) < kContinuityM;
+      if (z > 0.f && b < kBins && near) {
         ++hist[b + 1];
         ++total;
       }
@@ -52,9 +56,9 @@ double depthMode(const cv::Mat& roi, double near_m) {
   const double lo = (best - 2) * kBinM, hi = (best + 1) * kBinM;  // the peak bin +- one bin
   std::vector<float> vals;
   for (int y = 0; y < roi.rows; y += 2) {
-    const float* row = roi.ptr<float>(y);
     for (int x = 0; x < roi.cols; x += 2) {
-      if (row[x] > lo && row[x] < hi) vals.push_back(row[x]);
+      const float z = value(y, x);
+      if (z > lo && z < hi) vals.push_back(z);
     }
   }
   std::nth_element(vals.begin(), vals.begin() + vals.size() / 2, vals.end());
@@ -137,33 +141,40 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
   if (box.width < 4 || box.height < 4) return {};
   const cv::Rect inner(box.width / 4, box.height * 15 / 100, std::max(1, box.width / 2),
                        std::max(1, box.height * 70 / 100));  // in the box
-  cv::Mat z = depth_m(box);
+  const cv::Mat z = depth_m(box);
   const bool cut = !not_object.empty() || max_depth_m > 0.0;
-  if (cut) {
-    // Not the object's: its pixels on a support plane, and, farther than max_depth_m, where the
-    // object would be larger than it can be: that surface is behind it (the wall beside a
-    // walker cut by the border, a box left on the wall). Depth compared as float (cv::compare
-    // with a scalar; vectorised, where a loop mixing mask bytes and depth floats was not).
-    cv::Mat cut_z;
-    z.copyTo(cut_z);
-    if (max_depth_m > 0.0) cut_z.setTo(0.f, z > static_cast<float>(max_depth_m));
-    if (!not_object.empty()) cut_z.setTo(0.f, not_object(box));
-    z = cut_z;
+  // Not the object's (read as depth 0 below): its pixels on a support plane, and, farther than
+  // max_depth_m, where the object would be larger than it can be: that surface is behind it (the
+  // wall beside a walker cut by the border, a box left on the wall). Depth compared as float.
+  // (A mask, where copying the depth with them zeroed cost twice as much.)
+  cv::Mat dropped;
+  if (max_depth_m > 0.0) dropped = z > static_cast<float>(max_depth_m);
+  if (!not_object.empty()) {
+    const cv::Mat off = not_object(box) != 0;
+    dropped = dropped.empty() ? off : (dropped | off);
   }
-  double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m) : 0.0;
+  const cv::Mat dropped_inner = dropped.empty() ? cv::Mat() : dropped(inner);
+  double mode = prior_depth_m > 0.0 ? depthMode(z(inner), prior_depth_m, dropped_inner) : 0.0;
   if (mode <= 0.0) {
-    mode = depthMode(z(inner), 0.0);
+    mode = depthMode(z(inner), 0.0, dropped_inner);
     // Depth, but none near the prior: with prior_only the object has left the box.
     if (mode > 0.0 && prior_only && prior_depth_m > 0.0)
       return cv::Mat::zeros(depth_m.size(), CV_8UC1);
   }
   if (mode <= 0.0) {
-    const bool has_depth = cut && depthMode(depth_m(box)(inner), 0.0) > 0.0;
+    const bool has_depth = cut && depthMode(z(inner), 0.0) > 0.0;
     return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
   }
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
   const auto lo = static_cast<float>(mode - band_m), hi = static_cast<float>(mode + band_m);
   cv::Mat sel = (z > lo) & (z < hi);  // compared as float
+  if (!dropped.empty()) {             // a dropped pixel is selected as depth 0 would be
+    if (0.f > lo && 0.f < hi) {
+      sel |= dropped;
+    } else {
+      sel &= ~dropped;
+    }
+  }
   cv::morphologyEx(sel, sel, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
   if (!not_object.empty()) sel.setTo(0, not_object(box));
   cv::Mat labels;
