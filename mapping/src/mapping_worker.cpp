@@ -53,7 +53,10 @@ MappingWorker::~MappingWorker() {
 
 void MappingWorker::push(KeyframePacketPtr kf) {
   std::unique_lock<std::mutex> lock(mutex_);
-  not_full_.wait(lock, [this] { return queue_.size() < capacity_ || stopping_; });
+  if (queue_.size() >= capacity_ && !stopping_) {  // the tracker waits for the mapper
+    ScopedStageTimer wait(timings_, "mapping_wait");
+    not_full_.wait(lock, [this] { return queue_.size() < capacity_ || stopping_; });
+  }
   if (stopping_) return;
   queue_.push_back(std::move(kf));
   lock.unlock();

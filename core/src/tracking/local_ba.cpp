@@ -114,6 +114,7 @@ void LocalBundleAdjuster::runOnce(int window_keyframes, int max_iterations) {
 void LocalBundleAdjuster::applyFinished() {
   std::optional<BaWindow> solved;
   {
+    ScopedStageTimer wait(timings_, "ba_wait");  // the tracker waiting for the last solve
     std::unique_lock<std::mutex> lock(mutex_);
     wake_.wait(lock, [this] { return (!pending_ && !running_) || !thread_.joinable() || stop_; });
     solved.swap(solved_);
