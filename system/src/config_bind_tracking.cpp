@@ -16,6 +16,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.lk_window_px", &c.lk_window_px, 5, 63);
   schema.addInt("tracking.lk_max_iterations", &c.lk_max_iterations, 1, 200);
   schema.addDouble("tracking.lk_fb_threshold_px", &c.lk_fb_threshold_px, 0.01, 20.0);
+  schema.addInt("tracking.lk_backward_levels", &c.lk_backward_levels, 0, 10);
   schema.addInt("tracking.lk_threads", &c.lk_threads, 1, 2);
   schema.addInt("tracking.motion_probes", &c.motion_probes, 0, 10000);
   schema.addInt("tracking.motion_probe_min_distance_px", &c.motion_probe_min_distance_px, 1, 200);

@@ -178,7 +178,7 @@ void Tracker::Impl::matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d&
     }
   }
   std::vector<std::uint8_t> ok;
-  lk_.track(prev_pyramid_, cur, prev_px, cur_px, ok);
+  lk_.track(prev_pyramid_, cur, prev_px, cur_px, ok, config_.lk_backward_levels);
   std::vector<FeatureTrack> kept;
   kept.reserve(tracks_.size());
   for (std::size_t i = 0; i < tracks_.size(); ++i) {

@@ -20,6 +20,9 @@ struct TrackerConfig {
   int lk_window_px = 15;            ///< LK window side
   int lk_max_iterations = 20;       ///< LK iterations per level
   double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
+  /// Pyramid levels of the backward (consistency) pass of the landmark tracks, which starts from
+  /// the track's own position (0 = lk_levels). 5 of the 6, as the probes' below.
+  int lk_backward_levels = 5;
   /// Threads LK splits a frame's points over (each point is tracked alone: same result with
   /// any number). 2 helps where a core is free; on 2 cores the detector already fills it.
   int lk_threads = 1;
@@ -31,8 +34,10 @@ struct TrackerConfig {
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
   /// Pyramid levels of the probes' backward (consistency) pass, which starts from the probe's
-  /// own position (0 = lk_levels, as the landmark tracks).
-  int motion_probe_backward_levels = 0;
+  /// own position (0 = lk_levels). 5 of the 6: the coarsest (20 x 15 px) changed no trajectory
+  /// in 52 runs (BENCHMARKS.md, session 45) and cost a sixth of the pass; fewer levels pass more
+  /// probes at the edges of movers.
+  int motion_probe_backward_levels = 5;
 
   /// With a motion filter: the camera motion handed to it is first estimated against the
   /// tracked landmarks that at least this many keyframes observed (those proven static over
