@@ -15,14 +15,16 @@ struct TrackerConfig {
   int min_tracked_features = 100;  ///< fewer tracked features -> new keyframe + re-detection
 
   // --- Lucas-Kanade frame-to-frame matching ---
-  int lk_levels = 6;                ///< pyramid levels of Lucas-Kanade optical flow
+  /// Pyramid levels of Lucas-Kanade optical flow asked for. OpenCV builds only the levels larger
+  /// than the window: at 640 x 480 with a 15 px window that is 5 (the 6th would be 20 x 15 px).
+  int lk_levels = 6;
   double lk_scale = 0.5;            ///< scale between pyramid levels
   int lk_window_px = 15;            ///< LK window side
   int lk_max_iterations = 20;       ///< LK iterations per level
   double lk_fb_threshold_px = 1.0;  ///< forward-backward consistency threshold
   /// Pyramid levels of the backward (consistency) pass of the landmark tracks, which starts from
-  /// the track's own position (0 = lk_levels). 5 of the 6, as the probes' below.
-  int lk_backward_levels = 5;
+  /// the track's own position (0 = all that were built).
+  int lk_backward_levels = 0;
   /// Threads LK splits a frame's points over (each point is tracked alone: same result with
   /// any number). 2 helps where a core is free; on 2 cores the detector already fills it.
   int lk_threads = 1;
@@ -34,10 +36,9 @@ struct TrackerConfig {
   int motion_probes = 500;
   int motion_probe_min_distance_px = 12;  ///< spacing of probes (goodFeaturesToTrack)
   /// Pyramid levels of the probes' backward (consistency) pass, which starts from the probe's
-  /// own position (0 = lk_levels). 5 of the 6: the coarsest (20 x 15 px) changed no trajectory
-  /// in 52 runs (BENCHMARKS.md, session 45) and cost a sixth of the pass; fewer levels pass more
-  /// probes at the edges of movers.
-  int motion_probe_backward_levels = 5;
+  /// own position (0 = all that were built). Fewer levels pass more probes at the edges of
+  /// movers and move the masks of people who stand (BENCHMARKS.md, session 45).
+  int motion_probe_backward_levels = 0;
 
   /// With a motion filter: the camera motion handed to it is first estimated against the
   /// tracked landmarks that at least this many keyframes observed (those proven static over
