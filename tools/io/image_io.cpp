@@ -1,12 +1,27 @@
 #include "image_io.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "png_gray16.hpp"
+
 namespace dynamap {
+namespace {
+
+/// The file as a 16-bit greyscale PNG (png_gray16.hpp); empty when it is not one or cannot be
+/// read, for OpenCV to decide.
+cv::Mat readGray16Png(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (!file.good() && !file.eof()) return {};
+  return decodeGray16Png(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+}
+
+}  // namespace
 
 void writeImageAtomic(const std::string& path, const cv::Mat& image) {
   const std::string ext = std::filesystem::path(path).extension().string();
@@ -33,8 +48,9 @@ cv::Mat readImage(const std::string& path, int flags, std::string* error) {
     return {};
   }
   cv::Mat image;
+  if (flags == cv::IMREAD_UNCHANGED) image = readGray16Png(path);  // depth images: the fast way
   try {
-    image = cv::imread(path, flags);
+    if (image.empty()) image = cv::imread(path, flags);
   } catch (const cv::Exception&) {
     image.release();
   }
