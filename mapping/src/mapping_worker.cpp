@@ -165,7 +165,12 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   if (deferred()) {
     static_depth_m = staticDepth(kf.depth_m, mask, options_);
   } else {
-    StaticPoints sp = extractStaticPoints(camera_, kf.bgr, kf.depth_m, mask, options_);
+    StaticPoints sp;
+    sp.static_depth_m = staticDepth(kf.depth_m, mask, options_);
+    if (backend_->needsPoints()) {
+      backProjectDepth(camera_, kf.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                       &sp.colors);
+    }
     backend_->integrate(keyframeView(kf.id, kf.timestamp_s, kf.T_W_C, camera_, kf.bgr, sp));
     static_depth_m = sp.static_depth_m;
   }
@@ -283,8 +288,10 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
     const KeyframeRecord& rec = records_.at(id);
     rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
-    backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                     &sp.colors);
+    if (backend_->needsPoints()) {
+      backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                       &sp.colors);
+    }
   };
   const auto integrate = [this](std::uint64_t id, const StaticPoints& sp) {
     KeyframeRecord& rec = records_.at(id);

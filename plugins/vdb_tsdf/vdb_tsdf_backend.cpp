@@ -109,6 +109,7 @@ class VdbTsdfBackend final : public MapBackend {
   void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
   bool fusesViews() const override { return true; }
+  bool needsPoints() const override { return false; }
   void reset() override {
     volume_.reset();
     keyframes_ = 0;

@@ -71,6 +71,9 @@ class MapBackend {
   /// occupancy log-odds), so a few stray pixels of one view are outvoted; false: every observed
   /// point is kept. The worker grows dynamic masks less for a fusing backend.
   virtual bool fusesViews() const { return false; }
+  /// false: integrate() reads only `static_depth_m` and `bgr`, and the worker leaves `points_C`
+  /// and `colors` empty (a TSDF projects its voxels into the depth image; no points needed).
+  virtual bool needsPoints() const { return true; }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).
@@ -79,6 +82,7 @@ using BackendParams = std::map<std::string, std::string>;
 /// The one symbol a plugin exports (see plugin_api.hpp). Returns a new backend owned by the
 /// caller; throws MappingError for a bad parameter.
 using BackendFactoryFn = MapBackend* (*)(const BackendParams& params);
-inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v1";
+/// v2: MapBackend::needsPoints() (a plugin built for v1 has a shorter vtable: refused by name).
+inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v2";
 
 }  // namespace dynamap
