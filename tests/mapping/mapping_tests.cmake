@@ -30,8 +30,9 @@ add_custom_command(
   OUTPUT ${example_so}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${example_dir}
   COMMAND ${CMAKE_CXX_COMPILER} -std=c++17 -O2 -fPIC -shared -Wall -Wextra -Werror
-          ${example_includes} ${example_src} -o ${example_so}
+          ${example_includes} ${example_src} -o ${example_so} -MD -MF ${example_so}.d
   DEPENDS ${example_src}
+  DEPFILE ${example_so}.d  # rebuilt when a public header it includes changes (the plugin ABI)
   COMMENT "Building the out-of-tree example backend plugin"
   VERBATIM)
 add_custom_target(dynamap_example_plugin DEPENDS ${example_so})
