@@ -27,6 +27,7 @@ class PluginBackend final : public MapBackend {
   void exportMap(const std::string& dir) override { inner_->exportMap(dir); }
   MapStats stats() const override { return inner_->stats(); }
   bool fusesViews() const override { return inner_->fusesViews(); }
+  bool needsPoints() const override { return inner_->needsPoints(); }
 
  private:
   std::shared_ptr<void> handle_;

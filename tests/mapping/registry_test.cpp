@@ -14,6 +14,17 @@ TEST(BackendRegistry, FindsTheFourBuiltInPlugins) {
   }
 }
 
+// What a backend says of itself reaches the worker through the registry's wrapper (a capability
+// the wrapper does not forward reads as the default).
+TEST(BackendRegistry, CreatedBackendsSayWhatTheyNeedAndFuse) {
+  const auto registry = BackendRegistry::scan({pluginDir()});
+  EXPECT_FALSE(registry.create("vdb_tsdf", {})->needsPoints());  // projects voxels into depth
+  EXPECT_TRUE(registry.create("vdb_tsdf", {})->fusesViews());
+  EXPECT_TRUE(registry.create("points", {})->needsPoints());
+  EXPECT_FALSE(registry.create("points", {})->fusesViews());
+  EXPECT_TRUE(registry.create("octomap", {})->needsPoints());  // inserts point rays
+}
+
 TEST(BackendRegistry, UnknownNameListsThePluginsFound) {
   const auto registry = BackendRegistry::scan({pluginDir()});
   try {
