@@ -234,38 +234,56 @@ bool MappingWorker::removeSeenThroughLocked() {
 bool MappingWorker::reviseHeldLocked() {
   if (options_.held_revision_voxel_m <= 0.0 || order_.empty()) return false;
   ScopedStageTimer timer(timings_, "mapping_held_revision");
+  prepareHeldLocked();
   std::vector<HeldKeyframe> keyframes;
   keyframes.reserve(order_.size());
   for (const std::uint64_t id : order_) {
     KeyframeRecord& rec = records_.at(id);
     rec.held.T_W_C = rec.T_current;
-    if (!rec.held_depth_u16.empty())
-      rec.held_depth_u16.convertTo(rec.held.depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
     keyframes.push_back(std::move(rec.held));
   }
   const std::vector<cv::Mat> hits = heldConfirmedElsewhere(
       camera_, keyframes, options_.held_revision_voxel_m, options_.held_revision_min_keyframes);
+  std::vector<cv::Mat> revised(order_.size());
+  inTwo([&](int h) {  // every other keyframe: each thread writes only its keyframes' records
+    for (std::size_t i = static_cast<std::size_t>(h); i < order_.size(); i += 2) {
+      KeyframeRecord& rec = records_.at(order_[i]);
+      if (!hits[i].empty() && !rec.depth_u16.empty()) {
+        revised[i] = rec.dynamic_mask.clone();
+        revised[i].setTo(0, hits[i]);
+        const cv::Mat map_mask =
+            rec.extra_mask.empty() ? revised[i] : cv::max(revised[i], rec.extra_mask);
+        staticDepth(keyframes[i].depth_m, map_mask, options_)
+            .convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
+      }
+      rec.held = HeldKeyframe();  // done: its depth and masks are released
+      rec.dynamic_mask.release();
+      rec.extra_mask.release();
+    }
+  });
   bool any = false;
   for (std::size_t i = 0; i < order_.size(); ++i) {
-    KeyframeRecord& rec = records_.at(order_[i]);
-    if (!hits[i].empty() && !rec.depth_u16.empty()) {
-      cv::Mat revised = rec.dynamic_mask.clone();
-      revised.setTo(0, hits[i]);
-      const cv::Mat map_mask = rec.extra_mask.empty() ? revised : cv::max(revised, rec.extra_mask);
-      staticDepth(keyframes[i].depth_m, map_mask, options_)
-          .convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
-      // The visibility pass's mask votes keep reading the masks as they were: a person the
-      // revision wrongly unmasked (a swayer confirmed static now and then) is still voted out
-      // of the map by the views that masked him.
-      revised_masks_[order_[i]] = revised;
-      any = true;
-    }
-    rec.held = HeldKeyframe();  // done: its depth and masks are released
-    rec.held_depth_u16.release();
-    rec.dynamic_mask.release();
-    rec.extra_mask.release();
+    if (revised[i].empty()) continue;
+    // The visibility pass's mask votes keep reading the masks as they were: a person the
+    // revision wrongly unmasked (a swayer confirmed static now and then) is still voted out of
+    // the map by the views that masked him.
+    revised_masks_[order_[i]] = revised[i];
+    any = true;
   }
   return any;
+}
+
+// The held depths as metres: no pose needed, so drain() does it beside the last bundle
+// adjustment. Each keyframe once (its 16-bit copy is released).
+void MappingWorker::prepareHeldLocked() {
+  if (options_.held_revision_voxel_m <= 0.0) return;
+  const auto convert = [this](std::size_t i) {
+    KeyframeRecord& rec = records_.at(order_[i]);
+    if (rec.held_depth_u16.empty()) return;
+    rec.held_depth_u16.convertTo(rec.held.depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
+    rec.held_depth_u16.release();
+  };
+  for (std::size_t i = 0; i < order_.size(); ++i) convert(i);
 }
 
 std::unordered_map<std::uint64_t, cv::Mat> MappingWorker::revisedMasks() const {
@@ -314,16 +332,30 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   reintegrated_ = order_.size();
 }
 
+void MappingWorker::drain() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  not_empty_.notify_all();
+  not_full_.notify_all();
+  {
+    std::lock_guard<std::mutex> lock(join_mutex_);
+    if (thread_.joinable()) thread_.join();
+  }
+  std::lock_guard<std::mutex> lock(backend_mutex_);
+  if (drained_) return;
+  drained_ = true;
+  prepareHeldLocked();
+}
+
 void MappingWorker::finish() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) return;
     finished_ = true;
-    stopping_ = true;
   }
-  not_empty_.notify_all();
-  not_full_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  drain();
   std::vector<PoseUpdate> late;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -1,7 +1,9 @@
 #include "dynamap/system.hpp"
 
+#include <exception>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
@@ -258,10 +260,25 @@ void System::finish() {
   s.finished = true;
   s.releasePending(s.last_mapped);
   if (s.tracker) {
-    {
+    // The mapper integrates its last keyframes on the other core while the last bundle
+    // adjustment holds this one (it needs no pose; the final poses come after).
+    std::exception_ptr drain_failed;
+    std::thread drain([&] {
+      try {
+        s.mapper->drain();
+      } catch (...) {
+        drain_failed = std::current_exception();
+      }
+    });
+    try {
       ScopedStageTimer timer(s.timings, "finish_tracking");  // last bundle adjustment
       s.tracker->finish();
+    } catch (...) {
+      drain.join();
+      throw;
     }
+    drain.join();
+    if (drain_failed) std::rethrow_exception(drain_failed);
     std::vector<PoseUpdate> final_poses;
     for (const auto& kf : s.tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
     s.mapper->applyPoseUpdates(final_poses);

@@ -51,6 +51,11 @@ class MappingWorker {
   /// Non-blocking; returns false (and counts a drop) when the queue is full.
   bool tryPush(KeyframePacketPtr kf);
   void applyPoseUpdates(const std::vector<PoseUpdate>& updates);
+  /// Stops taking keyframes, integrates the queued ones and stops the thread, then prepares what
+  /// finish() needs that no pose changes (the held depths as metres). Meant to run beside the
+  /// tracker's last bundle adjustment; applyPoseUpdates() may be called during and after it.
+  /// finish() does it if it was not called. Idempotent.
+  void drain();
   /// Drains the queue, stops the thread, applies the final poses (rebuild if needed). Idempotent.
   void finish();
   void exportMap(const std::string& dir);
@@ -95,6 +100,7 @@ class MappingWorker {
   bool removeSeenThroughLocked();
   /// Unmasks held-back pixels that another keyframe confirmed static; true if any.
   bool reviseHeldLocked();
+  void prepareHeldLocked();
   void applyUpdateLocked(const PoseUpdate& update);
   /// Keyframes go to the backend only in finish() (see the class comment).
   bool deferred() const { return options_.visibility.enabled && options_.deferred_integration; }
@@ -112,6 +118,8 @@ class MappingWorker {
   std::vector<PoseUpdate> pending_updates_;
   bool stopping_ = false;
   bool finished_ = false;
+  bool drained_ = false;   ///< guarded by backend_mutex_
+  std::mutex join_mutex_;  ///< drain() may run on a helper thread: one join of thread_
   std::atomic<std::size_t> dropped_{0};
 
   mutable std::mutex backend_mutex_;  ///< guards backend_ and records_
