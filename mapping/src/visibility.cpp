@@ -32,7 +32,7 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-/// Runs fn(depth) for every static pixel of a keyframe, in the order forEachStaticPoint() takes.
+/// Runs fn(depth) for every static pixel of a keyframe, in the order keyPoints() takes.
 template <typename T, typename Fn>
 void forEachStaticPixelT(const VisibilityKeyframe& kf, const Fn& fn) {
   cv::Mat& depth = *kf.static_depth;
@@ -45,50 +45,57 @@ void forEachStaticPixelT(const VisibilityKeyframe& kf, const Fn& fn) {
   }
 }
 
-/// Runs fn(depth, u, v, p_W) for every static pixel of a keyframe.
-template <typename T, typename Fn>
-void forEachStaticPointT(const PinholeCamera& camera, const VisibilityKeyframe& kf, const Fn& fn) {
+/// A keyframe's points keyed by voxel and sorted. Row by row: first the points and keys of the
+/// row's static pixels (independent of each other), then the runs of equal keys. Thread-safe.
+template <typename T>
+void keyPointsT(const PinholeCamera& camera, const VisibilityKeyframe& kf, float inv_voxel,
+                KeyedPoints& out) {
   const Eigen::Isometry3f pose = kf.T_W_C.cast<float>();
-  cv::Mat& depth = *kf.static_depth;
+  const cv::Mat& depth = *kf.static_depth;
   const auto scale = static_cast<float>(kf.metres_per_unit);
   const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
   const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  out.points.resize(depth.total());  // at most one point a pixel; cut to size below
+  out.keys.resize(static_cast<std::size_t>(depth.cols));
+  Eigen::Vector3f* points = out.points.data();
+  std::uint64_t* keys = out.keys.data();
+  std::size_t n = 0;
   for (int v = 0; v < depth.rows; ++v) {
-    T* row = depth.ptr<T>(v);
+    const T* row = depth.ptr<T>(v);
     const float y_n = (static_cast<float>(v) - cy) / fy;
+    std::size_t m = 0;
     for (int u = 0; u < depth.cols; ++u) {
       const float z = static_cast<float>(row[u]) * scale;
       if (!(z > 0.0f)) continue;
-      fn(row[u], pose * Eigen::Vector3f((static_cast<float>(u) - cx) / fx * z, y_n * z, z));
+      const Eigen::Vector3f p_W =
+          pose * Eigen::Vector3f((static_cast<float>(u) - cx) / fx * z, y_n * z, z);
+      points[n + m] = p_W;
+      keys[m++] = vis::voxelKey(p_W, inv_voxel);
     }
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!out.runs.empty() && out.runs.back().key == keys[i]) {
+        ++out.runs.back().count;
+      } else {
+        out.runs.push_back({keys[i], static_cast<std::uint32_t>(out.starts.size()), 1});
+        out.starts.push_back(static_cast<std::uint32_t>(n + i));
+      }
+    }
+    n += m;
   }
-}
-template <typename Fn>
-void forEachStaticPoint(const PinholeCamera& camera, const VisibilityKeyframe& kf, const Fn& fn) {
-  if (kf.static_depth->type() == CV_16UC1) {
-    forEachStaticPointT<std::uint16_t>(camera, kf, fn);
-  } else {
-    forEachStaticPointT<float>(camera, kf, fn);
-  }
+  out.points.resize(n);
 }
 
-/// A keyframe's points keyed by voxel and sorted. Thread-safe.
+/// A keyframe's points keyed by voxel, the runs sorted by (key, first point). Thread-safe.
 void keyPoints(const PinholeCamera& camera, const VisibilityKeyframe& kf, float inv_voxel,
                KeyedPoints& out) {
   out.runs.clear();
   out.starts.clear();
   out.points.clear();
-  forEachStaticPoint(camera, kf, [&](auto&, const Eigen::Vector3f& p_W) {
-    const std::uint64_t key = vis::voxelKey(p_W, inv_voxel);
-    const auto index = static_cast<std::uint32_t>(out.points.size());
-    out.points.push_back(p_W);
-    if (!out.runs.empty() && out.runs.back().key == key) {
-      ++out.runs.back().count;
-    } else {
-      out.runs.push_back({key, static_cast<std::uint32_t>(out.starts.size()), 1});
-      out.starts.push_back(index);
-    }
-  });
+  if (kf.static_depth->type() == CV_16UC1) {
+    keyPointsT<std::uint16_t>(camera, kf, inv_voxel, out);
+  } else {
+    keyPointsT<float>(camera, kf, inv_voxel, out);
+  }
   // Made in point order: a stable sort by voxel gives (key, first) order.
   radixSortByKey(out.runs, out.scratch, [](const VoxelRun& r) { return r.key; });
 }

@@ -58,6 +58,7 @@ struct KeyedPoints {
   std::vector<VoxelRun> scratch;  ///< for the sort
   std::vector<std::uint32_t> starts;
   std::vector<Eigen::Vector3f> points;
+  std::vector<std::uint64_t> keys;  ///< one row's keys, while keying
 };
 
 /// A keyframe's runs in point order: each run's element (2 x index + part) and length. The
