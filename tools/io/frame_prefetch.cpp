@@ -1,69 +1,29 @@
 #include "frame_prefetch.hpp"
 
-#include <exception>
-
 namespace dynamap {
 
-FramePrefetcher::FramePrefetcher(const TumSequence& sequence,
-                                 std::function<void(const RgbdFrame&)> on_read)
-    : sequence_(sequence), on_read_(std::move(on_read)), thread_([this] { loop(); }) {}
-
 FramePrefetcher::~FramePrefetcher() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;  // a frame being read is finished first: the thread uses sequence_
-  }
-  changed_.notify_all();
-  thread_.join();
-}
-
-void FramePrefetcher::loop() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  for (;;) {
-    changed_.wait(lock, [this] { return stop_ || wanted_.has_value(); });
-    if (stop_) return;
-    const std::size_t index = *wanted_;
-    wanted_.reset();
-    lock.unlock();
-    FrameLoad load;
-    std::exception_ptr failure;
-    try {
-      load = sequence_.load(index);
-      if (load.ok && on_read_) on_read_(load.frame);
-    } catch (...) {
-      failure = std::current_exception();  // thrown again by take(), on the caller's thread
-    }
-    lock.lock();
-    ready_ = std::move(load);
-    failure_ = failure;
-    ready_index_ = index;
-    busy_ = false;
-    changed_.notify_all();
-  }
+  if (pending_.valid()) pending_.wait();  // the reading thread uses sequence_: let it finish
 }
 
 FrameLoad FramePrefetcher::take(std::size_t index) {
-  std::optional<FrameLoad> load;
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return !busy_; });  // a frame skipped (--realtime): not needed
-    if (ready_ && ready_index_ == index) {
-      if (failure_) std::rethrow_exception(std::exchange(failure_, nullptr));
-      load = std::move(ready_);
-    }
-    ready_.reset();
-    failure_ = nullptr;
+  FrameLoad load;
+  if (pending_.valid() && pending_index_ == index) {
+    load = pending_.get();
+  } else {
+    if (pending_.valid()) pending_.wait();  // a frame skipped (--realtime): not needed
+    pending_ = {};
+    load = sequence_.load(index);
   }
-  if (!load) load = sequence_.load(index);
   if (index + 1 < sequence_.size()) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      wanted_ = index + 1;
-      busy_ = true;
-    }
-    changed_.notify_all();
+    pending_index_ = index + 1;
+    pending_ = std::async(std::launch::async, [this, next = index + 1] {
+      FrameLoad next_load = sequence_.load(next);
+      if (next_load.ok && on_read_) on_read_(next_load.frame);
+      return next_load;
+    });
   }
-  return std::move(*load);
+  return load;
 }
 
 }  // namespace dynamap

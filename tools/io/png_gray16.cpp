@@ -108,9 +108,7 @@ cv::Mat decodeGray16Png(const std::uint8_t* data, std::size_t size, std::size_t 
   std::size_t pos = 8;
   int width = 0, height = 0;
   std::size_t row_bytes = 0;
-  // The inflated rows: one buffer a thread, kept between images (a fresh one costs its page
-  // faults, ~10 % of the decode).
-  thread_local std::vector<std::uint8_t> raw;
+  std::unique_ptr<std::uint8_t[]> raw;  // the inflated rows (not zeroed: inflate fills them)
   std::unique_ptr<Inflater> inflater;
   enum class Stage { kHeader, kBeforeData, kData, kAfterData, kEnd } stage = Stage::kHeader;
   while (pos + 12 <= size && stage != Stage::kEnd) {
@@ -134,8 +132,8 @@ cv::Mat decodeGray16Png(const std::uint8_t* data, std::size_t size, std::size_t 
       height = static_cast<int>(h);
       row_bytes = std::size_t{w} * 2;
       const std::size_t raw_size = (row_bytes + 1) * h;
-      if (raw.size() < raw_size) raw.resize(raw_size);
-      inflater = std::make_unique<Inflater>(raw.data(), raw_size);
+      raw.reset(new std::uint8_t[raw_size]);
+      inflater = std::make_unique<Inflater>(raw.get(), raw_size);
       stage = Stage::kBeforeData;
     } else if (isType(type, "IDAT")) {
       if (stage == Stage::kAfterData || !inflater->feed(body, length)) return {};
@@ -154,7 +152,7 @@ cv::Mat decodeGray16Png(const std::uint8_t* data, std::size_t size, std::size_t 
   const std::vector<std::uint8_t> zeros(row_bytes, 0);
   const std::uint8_t* up = zeros.data();
   for (int y = 0; y < height; ++y) {
-    std::uint8_t* line = raw.data() + static_cast<std::size_t>(y) * (row_bytes + 1);
+    std::uint8_t* line = raw.get() + static_cast<std::size_t>(y) * (row_bytes + 1);
     if (!unfilterRow(line[0], line + 1, up, row_bytes)) return {};
     up = line + 1;
     std::uint16_t* out = image.ptr<std::uint16_t>(y);
