@@ -1,6 +1,7 @@
 #include "tsdf_volume.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <openvdb/io/File.h>
@@ -162,6 +163,7 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
   const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
   const bool has_colour = !bgr.empty() && bgr.size() == depth_m.size();
   const Eigen::Vector3f step_z = R.col(2) * vs;
+  const auto cols = static_cast<float>(depth_m.cols), rows = static_cast<float>(depth_m.rows);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
     for (std::size_t b = range.begin(); b < range.end(); ++b) {
       FloatLeaf& tl = *tsdf_leaves[b];
@@ -171,16 +173,29 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
       const openvdb::Coord o = blocks[b];
       for (int x = 0; x < kLeafDim; ++x) {
         for (int y = 0; y < kLeafDim; ++y) {
+          // The column's 8 voxels: their camera points one step apart (summed in order), then
+          // their projections side by side (no branch: the compiler does 4 at a time), then
+          // the checks and updates one by one.
+          std::array<float, kLeafDim> px, py, pz, uf, vf;
           Eigen::Vector3f p_C = R * (Eigen::Vector3f(o.x() + x, o.y() + y, o.z()) * vs) + t;
           for (int z = 0; z < kLeafDim; ++z, p_C += step_z) {
-            if (p_C.z() <= 0.05f) continue;
-            const float inv_z = 1.0f / p_C.z();
-            const int u = static_cast<int>(fx * p_C.x() * inv_z + cx + 0.5f);
-            const int v = static_cast<int>(fy * p_C.y() * inv_z + cy + 0.5f);
-            if (u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+            px[z] = p_C.x();
+            py[z] = p_C.y();
+            pz[z] = p_C.z();
+          }
+          for (int z = 0; z < kLeafDim; ++z) {
+            const float inv_z = 1.0f / pz[z];
+            uf[z] = fx * px[z] * inv_z + cx + 0.5f;
+            vf[z] = fy * py[z] * inv_z + cy + 0.5f;
+          }
+          for (int z = 0; z < kLeafDim; ++z) {
+            if (pz[z] <= 0.05f) continue;
+            // static_cast<int> truncates: the pixel is inside iff -1 < uf < cols (NaN is not).
+            if (!(uf[z] > -1.0f && vf[z] > -1.0f && uf[z] < cols && vf[z] < rows)) continue;
+            const int u = static_cast<int>(uf[z]), v = static_cast<int>(vf[z]);
             const float d = depth_m.at<float>(v, u);
             if (!(d > 0.0f)) continue;
-            const float sdf = d - p_C.z();
+            const float sdf = d - pz[z];
             if (sdf < -trunc) continue;
             const openvdb::Index n = (x << 6) | (y << 3) | z;
             if (fl != nullptr && sdf > trunc) {
