@@ -5,6 +5,11 @@
 #include <cmath>
 #include <optional>
 
+#ifdef __linux__
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
+
 #include "in_two.hpp"
 
 namespace dynamap {
@@ -30,11 +35,12 @@ bool movedBeyond(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double 
 
 MappingWorker::MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
                              const StaticPointsOptions& options, std::size_t queue_capacity,
-                             TimingRecorder* timings)
+                             TimingRecorder* timings, int thread_nice)
     : backend_(std::move(backend)),
       camera_(camera),
       options_(options),
       capacity_(std::max<std::size_t>(1, queue_capacity)),
+      thread_nice_(thread_nice),
       timings_(timings) {
   if (!backend_) throw MappingError("MappingWorker: null backend");
   if (backend_->fusesViews()) options_.mask_dilation_px = options_.fused_mask_dilation_px;
@@ -84,6 +90,11 @@ void MappingWorker::applyPoseUpdates(const std::vector<PoseUpdate>& updates) {
 }
 
 void MappingWorker::run() {
+#ifdef __linux__
+  // This thread only (Linux applies a thread id's nice to that thread). A refusal changes nothing
+  // but the scheduling, so it is ignored.
+  if (thread_nice_ != 0) (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), thread_nice_);
+#endif
   for (;;) {
     KeyframePacketPtr kf;
     std::vector<PoseUpdate> updates;

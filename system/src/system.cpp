@@ -120,9 +120,9 @@ System::System(const AppConfig& config, SystemOptions options) : impl_(std::make
   const auto registry = BackendRegistry::scan(dirs);
   auto backend = registry.create(config.mapping.backend,
                                  paramsForBackend(config.mapping.params, config.mapping.backend));
-  s.mapper =
-      std::make_unique<MappingWorker>(std::move(backend), s.camera, config.mapping.static_points,
-                                      s.options.mapping_queue_capacity, s.timings);
+  s.mapper = std::make_unique<MappingWorker>(
+      std::move(backend), s.camera, config.mapping.static_points, s.options.mapping_queue_capacity,
+      s.timings, s.options.drop_keyframes_when_busy ? 0 : s.options.mapping_thread_nice);
   s.motion_filter = std::move(s.options.motion_filter);
   if (s.options.given_poses) return;
   if (!s.motion_filter) {

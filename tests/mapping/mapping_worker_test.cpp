@@ -1,7 +1,18 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <condition_variable>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifdef __linux__
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
 
 #include "mapping_test_utils.hpp"
 
@@ -92,6 +103,47 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   ASSERT_EQ(log.points.size(), 2u);
   EXPECT_GT(log.points[0], 1000u);
 }
+
+#ifdef __linux__
+/// The nice value of each of this process's threads (/proc/self/task/<tid>/stat, field 19).
+std::vector<int> threadNiceValues() {
+  std::vector<int> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream in(task.path() / "stat");
+    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::istringstream fields(stat.substr(stat.rfind(')') + 2));  // after "pid (name) "
+    std::string field;
+    for (int i = 3; i <= 19 && fields >> field; ++i) {
+    }
+    out.push_back(std::stoi(field));
+  }
+  return out;
+}
+
+// The mapping thread alone takes the nice value it is given; the caller's thread keeps its own.
+TEST(MappingWorker, ThreadNiceAppliesToTheMappingThreadOnly) {
+  FakeLog log;
+  TimingRecorder timings;
+  const std::vector<int> start = threadNiceValues();
+  const int before = static_cast<int>(std::count(start.begin(), start.end(), 7));
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), countingOptions(), 2, &timings, 7);
+  int with_seven = 0;
+  for (int i = 0; i < 2000 && with_seven <= before; ++i) {  // the thread sets it when it starts
+    const std::vector<int> nice = threadNiceValues();
+    with_seven = static_cast<int>(std::count(nice.begin(), nice.end(), 7));
+    if (with_seven <= before) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(with_seven, before + 1);
+  EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())), 0);
+  {
+    std::lock_guard<std::mutex> lock(log.mutex);
+    log.released = true;
+  }
+  log.cv.notify_all();
+  worker.finish();
+}
+#endif
 
 TEST(MappingWorker, FreeSpaceWindowIntegratesEveryKeyframeInOrderByFinish) {
   FakeLog log;

@@ -56,6 +56,11 @@ struct SystemOptions {
   /// A keyframe the busy mapper cannot take is dropped (counted) instead of waited for.
   bool drop_keyframes_when_busy = false;
   std::size_t mapping_queue_capacity = 16;
+  /// The mapping thread's nice value (Linux; 0 = the process's). Nothing waits for the mapper
+  /// while its queue has room, so with both cores busy it takes the gaps and leaves the tracker
+  /// and detector theirs; what is left is drained beside the last bundle adjustment. Not applied
+  /// with drop_keyframes_when_busy (a starved mapper would drop keyframes there).
+  int mapping_thread_nice = 19;
   /// Where every stage records its timings (borrowed; must outlive the System). Null = the
   /// System keeps its own (timings()).
   TimingRecorder* timings = nullptr;

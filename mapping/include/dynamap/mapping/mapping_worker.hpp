@@ -41,7 +41,7 @@ class MappingWorker {
 
   MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
                 const StaticPointsOptions& options, std::size_t queue_capacity,
-                TimingRecorder* timings);
+                TimingRecorder* timings, int thread_nice = 0);
   ~MappingWorker();
   MappingWorker(const MappingWorker&) = delete;
   MappingWorker& operator=(const MappingWorker&) = delete;
@@ -109,6 +109,7 @@ class MappingWorker {
   PinholeCamera camera_;
   StaticPointsOptions options_;
   std::size_t capacity_;
+  int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
   mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, stopping_
