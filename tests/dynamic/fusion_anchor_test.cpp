@@ -152,9 +152,9 @@ TEST(FusionAnchors, APersonStandingStillSwaysACentimetreAndIsKept) {
   EXPECT_LT(px_only, 0.9) << px_only;
 }
 
-/// A person 2 m away, still for 20 frames (kept), then one frame in which every point on him is
-/// flagged and his points sit `shift_px` to the side. Returns that frame's result.
-FusionResult flaggedAfterStandingStill(float shift_px) {
+/// A person 2 m away, still for 20 frames (kept), then `off` frames in which every point on him
+/// is flagged and his points sit `shift_px` to the side. Returns the last frame's result.
+FusionResult flaggedAfterStandingStill(float shift_px, int off = 1) {
   DynamicConfig c;
   FusionEvidence ev;
   ev.has_pose = true;
@@ -162,8 +162,8 @@ FusionResult flaggedAfterStandingStill(float shift_px) {
   ev.flags_valid = true;
   RegionFusion fusion(c, ClassTable(c));
   FusionResult r;
-  for (int i = 0; i <= 20; ++i) {
-    const SidewaysFrame f = sidewaysFrame(i == 20 ? shift_px : 0.f, i == 20, ev);
+  for (int i = 0; i < 20 + off; ++i) {
+    const SidewaysFrame f = sidewaysFrame(i >= 20 ? shift_px : 0.f, i >= 20, ev);
     r = fusion.fuse(FusionMode::kBoth, f.depth, f.points, f.flags, {kPersonBox}, ev);
     if (i == 19) {
       EXPECT_FALSE(r.objects.at(0).moving) << "kept before the flagged frame";
@@ -180,8 +180,13 @@ TEST(FusionAnchors, FlagsOnAPersonKeptStillThatHisAnchorsDoNotConfirmAreHeldNotE
   EXPECT_TRUE(unconfirmed.objects.at(0).moving);
   EXPECT_EQ(unconfirmed.mask.at<uchar>(centre), 255);
   EXPECT_EQ(unconfirmed.held.at<uchar>(centre), 255);
-  // 12 px (4.5 cm): the anchors confirm it, he moved: masked and not held.
-  const FusionResult moved = flaggedAfterStandingStill(12.f);
+  // 12 px (4.5 cm), twice the limit, in one frame: held as well (static_anchor_move_frames: a
+  // person confirmed still needs a second such frame to have moved).
+  const FusionResult once = flaggedAfterStandingStill(12.f);
+  EXPECT_EQ(once.mask.at<uchar>(centre), 255);
+  EXPECT_EQ(once.held.at<uchar>(centre), 255);
+  // ... and in the next frame too: the anchors confirm it, he moved: masked and not held.
+  const FusionResult moved = flaggedAfterStandingStill(12.f, 2);
   EXPECT_TRUE(moved.objects.at(0).moving);
   EXPECT_EQ(moved.mask.at<uchar>(centre), 255);
   EXPECT_EQ(moved.held.at<uchar>(centre), 0);

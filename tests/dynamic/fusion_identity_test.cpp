@@ -62,8 +62,8 @@ TEST(TrackIdentity, TheTrackHoldingMostOfThePointsOfTheSameClass) {
 /// Runs `frames` frames of one RegionFusion; `frame(s, i)` sets up frame i's scene and returns
 /// its detections. Returns whether the first object is masked in each frame from `from` on.
 std::vector<bool> maskedFrom(int frames, int from,
-                             const std::function<std::vector<Detection>(Scene&, int)>& frame) {
-  DynamicConfig c;
+                             const std::function<std::vector<Detection>(Scene&, int)>& frame,
+                             const DynamicConfig& c = DynamicConfig()) {
   RegionFusion fusion(c, ClassTable(c));
   std::vector<bool> masked;
   for (int i = 0; i < frames; ++i) {
@@ -99,27 +99,44 @@ TEST(TrackIdentity, AHalfHiddenStandingPersonKeepsTheEvidenceOnItsPoints) {
   EXPECT_TRUE(by_box.front());
 }
 
-/// A person confirmed still for 10 frames; in frame 10 all their points are flagged and seen
-/// `jump_px` off (the flags of one frame); then they are back where they were. Masked per frame
-/// 10-15.
-std::vector<bool> maskedAfterOneFlaggedFrame(float jump_px) {
+/// A person confirmed still for 10 frames; in frames 10 .. 10 + off - 1 all their points are
+/// flagged and seen `jump_px` off (the flags of those frames); then they are back where they
+/// were. Masked per frame from 10 on (18 frames in all).
+std::vector<bool> maskedAfterFlaggedFrames(float jump_px, int off,
+                                           const DynamicConfig& c = DynamicConfig()) {
   const cv::Rect person(280, 100, 80, 280);
-  return maskedFrom(16, 10, [&](Scene& s, int i) {
-    s.depth(person).setTo(2.f);
-    if (i == 10) s.disturb(person, jump_px);
-    return std::vector<Detection>{box(person)};
-  });
+  return maskedFrom(
+      18, 10,
+      [&](Scene& s, int i) {
+        s.depth(person).setTo(2.f);
+        if (i >= 10 && i < 10 + off) s.disturb(person, jump_px);
+        return std::vector<Detection>{box(person)};
+      },
+      c);
 }
 
 TEST(TrackIdentity, OneFlaggedFrameTheAnchorsDoNotConfirmMasksButDoesNotRestartTheCount) {
   // 6 px: beyond the anchors' still limit (at 2 m static_anchor_m's 1.5 cm, 4.0 px; more than
   // static_anchor_px 3), within twice it.
-  const std::vector<bool> jitter = maskedAfterOneFlaggedFrame(6.f);
+  const std::vector<bool> jitter = maskedAfterFlaggedFrames(6.f, 1);
   EXPECT_TRUE(jitter[0]);   // removing takes one frame
   EXPECT_FALSE(jitter[1]);  // back in place: kept at once, the count went on
-  // 10 px: the anchors say it moved, the count starts again (static_confirm_frames = 5).
-  const std::vector<bool> moved = maskedAfterOneFlaggedFrame(10.f);
-  for (int i = 0; i < 5; ++i) EXPECT_TRUE(moved[static_cast<std::size_t>(i)]) << i;
+}
+
+// Anchors off by more than twice the still limit (10 px) in one frame only: masked in it, kept
+// at once after (the count goes on); in two frames in a row: the count starts again
+// (static_confirm_frames = 5: masked in the two and at least the 4 frames after).
+TEST(TrackIdentity, AConfirmedPersonsAnchorsFarOffInOneFrameOnlyDoNotRestartTheCount) {
+  const std::vector<bool> once = maskedAfterFlaggedFrames(10.f, 1);
+  EXPECT_TRUE(once[0]);
+  for (std::size_t i = 1; i < once.size(); ++i) EXPECT_FALSE(once[i]) << i;
+  const std::vector<bool> twice = maskedAfterFlaggedFrames(10.f, 2);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_TRUE(twice[i]) << i;
+  // static_anchor_move_frames = 1: the first such frame restarts the count.
+  DynamicConfig first;
+  first.static_anchor_move_frames = 1;
+  const std::vector<bool> at_once = maskedAfterFlaggedFrames(10.f, 1, first);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_TRUE(at_once[i]) << i;
 }
 
 }  // namespace

@@ -220,7 +220,16 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   const bool anchored = tau > 0.0 && d.anchor.points >= kAnchorMinPoints;
   const double tau_z = config_.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   const bool anchor_still = anchored && d.anchor.median_px <= tau && dz <= tau_z;
-  const bool anchor_moved = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
+  const bool anchors_off = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
+  // A person confirmed still whose anchors jump from within the still limit to beyond twice it in
+  // one frame (a pose error there, or the semi-synthetic sequences' ground-truth jitter) is
+  // masked in it, but held like a flag storm: his still count and his anchors restart only when
+  // the next frame sees them off again. His count decides (kept through frames masked for
+  // anchors off by less).
+  const bool counted_still = prev != nullptr && prev->quiet_frames >= config_.static_confirm_frames;
+  const bool anchor_moved = anchors_off && !(config_.static_anchor_move_frames > 1 &&
+                                             counted_still && prev->anchors_still);
+  const bool confirmed_before = counted_still && !prev->moving;
   // Flags the anchors do not confirm were measured against a wrong camera motion: they mask
   // the object in this frame (below) but restart neither its quiet count nor its anchors.
   const bool flagged_now = d.moving_now;
@@ -230,6 +239,7 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   ObjectTrack t;
   t.box = d.detection.box;
   t.depth_m = d.depth_m > 0.0 || prev == nullptr ? d.depth_m : prev->depth_m;
+  t.anchors_still = anchor_still;
   t.class_id = d.detection.class_id;
   // A depth cut that jumped is another surface (the track went to another object): it starts
   // with no slow moves.
@@ -280,8 +290,6 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   if (d.moving_now) t.has_anchor = false, t.anchors = d.anchor.fresh;
   // A person confirmed still whose flags its anchors do not confirm (they drifted, but less than
   // twice the pose noise) is masked now but held: hindsight may keep him in the map.
-  const bool confirmed_before =
-      prev != nullptr && !prev->moving && prev->quiet_frames >= config_.static_confirm_frames;
   const bool unconfirmed_flags = confirmed_before && anchored && !anchor_moved;
   d.motion_now = (flagged_now && !unconfirmed_flags) || anchor_moved || t.moving;
   if (classes_.isHighDynamic(d.detection.class_id)) {

@@ -104,6 +104,9 @@ struct DynamicConfig {
   /// ... and their signed median depth difference within this (m): a sway along the line of
   /// sight. Twice either threshold is motion: the count of quiet frames starts over.
   double static_anchor_depth_m = 0.03;
+  /// For a person already confirmed still: frames in a row his anchors must be off by twice the
+  /// limit before the count starts over (1 = the first one). Masked (held) in those frames.
+  int static_anchor_move_frames = 2;
   /// Dense check without a detector: the depth of the frame this many frames back (0 = off),
   /// seen from the current pose, against the current depth. Pixels it saw through (beyond
   /// the sensor noise), outside the detected objects, in groups of at least dense_min_region_px,

@@ -57,6 +57,7 @@ struct ObjectTrack {
   /// Times its anchors showed motion that no frame-to-frame check saw (a sway, a slow step):
   /// each doubles the quiet frames it needs to be kept (at most 16 x).
   int slow_moves = 0;
+  bool anchors_still = false;  ///< its anchors were within the still limit
   bool moving = false;
 };
 
