@@ -223,9 +223,8 @@ ObjectTrack RegionFusion::decideObject(ObjectDecision& d, const ObjectTrack* pre
   const bool anchors_off = anchored && (d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z);
   // A person confirmed still whose anchors jump from within the still limit to beyond twice it in
   // one frame (a pose error there, or the semi-synthetic sequences' ground-truth jitter) is
-  // masked in it, but held like a flag storm: his still count and his anchors restart only when
-  // the next frame sees them off again. His count decides (kept through frames masked for
-  // anchors off by less).
+  // masked in it (held, as for a flag storm, if he was kept in the frame before); his still
+  // count and his anchors restart only when the next frame sees them off again.
   const bool counted_still = prev != nullptr && prev->quiet_frames >= config_.static_confirm_frames;
   const bool anchor_moved = anchors_off && !(config_.static_anchor_move_frames > 1 &&
                                              counted_still && prev->anchors_still);
