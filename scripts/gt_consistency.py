@@ -19,13 +19,16 @@ run's keyframe masks cover (RUN/masks from `dynamap run --save-masks`, SEQ/mask 
 under the run; then the means and the pairs above --limit (2.5 px) for each.
 """
 import argparse
+import functools
 import os
 import sys
 
 import cv2
 import numpy as np
 
-K = None  # 3x3 intrinsics, set in main()
+from motion_vs_gt import draw_legend, standing_share
+
+ORB = cv2.ORB_create(1500)
 
 
 def read_poses(path):
@@ -75,11 +78,25 @@ def nearest(items, t, max_dt=0.02):
     return best[1] if abs(best[0] - t) <= max_dt else None
 
 
-def static_matches(seq, rgb_a, rgb_b, depth_a, t_a, t_b, orb):
-    ia, ib = cv2.imread(rgb_a, cv2.IMREAD_GRAYSCALE), cv2.imread(rgb_b, cv2.IMREAD_GRAYSCALE)
+@functools.lru_cache(maxsize=2)
+def features(rgb):
+    """ORB keypoints and descriptors of a colour image: each frame is the second of one pair and
+    the first of the next."""
+    return ORB.detectAndCompute(cv2.imread(rgb, cv2.IMREAD_GRAYSCALE), None)
+
+
+@functools.lru_cache(maxsize=2)
+def person_mask(seq, t):
+    """The sequence's mask of the frame with stamp t (!= 0: a person), or None."""
+    path = os.path.join(seq, "mask", "%.6f.png" % t)
+    return cv2.imread(path, cv2.IMREAD_GRAYSCALE) if os.path.exists(path) else None
+
+
+def static_matches(seq, rgb_a, rgb_b, depth_a, t_a, t_b, K):
+    """Matches of frame a and b off people and with depth in a: a's points lifted (3 x n), b's
+    pixels (n x 2)."""
     depth = cv2.imread(depth_a, cv2.IMREAD_UNCHANGED).astype(np.float64) / 5000.0
-    ka, da = orb.detectAndCompute(ia, None)
-    kb, db = orb.detectAndCompute(ib, None)
+    (ka, da), (kb, db) = features(rgb_a), features(rgb_b)
     if da is None or db is None:
         return None
     m = cv2.BFMatcher(cv2.NORM_HAMMING, crossCheck=True).match(da, db)
@@ -88,32 +105,19 @@ def static_matches(seq, rgb_a, rgb_b, depth_a, t_a, t_b, orb):
     ua, ub = pa.astype(int), pb.astype(int)
     z = depth[ua[:, 1], ua[:, 0]]
     keep = (z > 0.3) & (z < 4.0)
-    mask_a = os.path.join(seq, "mask", "%.6f.png" % t_a)
-    mask_b = os.path.join(seq, "mask", "%.6f.png" % t_b)
-    if os.path.exists(mask_a) and os.path.exists(mask_b):
-        ma, mb = cv2.imread(mask_a, cv2.IMREAD_GRAYSCALE), cv2.imread(mask_b, cv2.IMREAD_GRAYSCALE)
+    ma, mb = person_mask(seq, t_a), person_mask(seq, t_b)
+    if ma is not None and mb is not None:
         keep &= (ma[ua[:, 1], ua[:, 0]] == 0) & (mb[ub[:, 1], ub[:, 0]] == 0)
     pa, pb, z = pa[keep], pb[keep], z[keep]
     x_a = np.linalg.inv(K) @ np.vstack([pa.T, np.ones(len(pa))]) * z
     return x_a, pb
 
 
-def reprojection(x_a, pb, pose_a, pose_b):
+def reprojection(x_a, pb, pose_a, pose_b, K):
     (ra, ta), (rb, tb) = pose_a, pose_b
     x_b = rb.T @ (ra @ x_a + (ta - tb)[:, None])
     u = K @ x_b
     return np.linalg.norm((u[:2] / u[2]).T - pb, axis=1)
-
-
-def standing_share(seq, run):
-    """{stamp: share of the standing person (mask value 128) under the run's keyframe mask}."""
-    out, folder = {}, os.path.join(run, "masks")
-    for name in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
-        gt = cv2.imread(os.path.join(seq, "mask", name), cv2.IMREAD_GRAYSCALE)
-        mask = cv2.imread(os.path.join(folder, name), cv2.IMREAD_GRAYSCALE)
-        if gt is not None and mask is not None and (gt == 128).any():
-            out[float(name[:-4])] = float(((gt == 128) & (mask > 0)).sum() / (gt == 128).sum())
-    return out
 
 
 def plot(path, rows, limit, bars):
@@ -139,18 +143,15 @@ def plot(path, rows, limit, bars):
     for label, col, colour in series:
         pts = np.array([xy(r[0], r[col]) for r in rows], np.int32)
         cv2.polylines(img, [pts], False, colour, 1, cv2.LINE_AA)
-    if bars:
-        series.append(("standing person masked (share of him, keyframes)", 0, (210, 210, 210)))
-    for i, (label, _, colour) in enumerate(series):
-        cv2.rectangle(img, (left + 10, top + 2 + 18 * i), (left + 24, top + 12 + 18 * i), colour, -1)
-        cv2.putText(img, label, (left + 30, top + 12 + 18 * i), 0, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
+    draw_legend(img, [(label, colour) for label, _, colour in series] +
+                ([("standing person masked (share of him, keyframes)", (210, 210, 210))]
+                 if bars else []), left, top)
     cv2.putText(img, "median reprojection error of static features between consecutive frames "
                 "[px]; time [s]", (left, h - 12), 0, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.imwrite(path, img)
 
 
 def main():
-    global K
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("seq")
     ap.add_argument("run")
@@ -163,19 +164,19 @@ def main():
     gt = read_poses(os.path.join(args.seq, "groundtruth.txt"))
     est = read_poses(os.path.join(args.run, "trajectory.txt"))
     rgb, depth = listing(args.seq, "rgb.txt"), listing(args.seq, "depth.txt")
-    orb = cv2.ORB_create(1500)
     rows = []
     for a, b in zip(est[:-1], est[1:]):
         ga, gb = gt_pose(gt, a[0]), gt_pose(gt, b[0])
         rgb_a, rgb_b, depth_a = nearest(rgb, a[0], 1e-4), nearest(rgb, b[0], 1e-4), nearest(depth, a[0])
         if ga is None or gb is None or None in (rgb_a, rgb_b, depth_a):
             continue
-        found = static_matches(args.seq, rgb_a, rgb_b, depth_a, a[0], b[0], orb)
+        found = static_matches(args.seq, rgb_a, rgb_b, depth_a, a[0], b[0], K)
         if found is None or found[1].shape[0] < 20:
             continue
         x_a, pb = found
-        e_gt = reprojection(x_a, pb, ga, gb)
-        e_run = reprojection(x_a, pb, (quat_to_rot(a[4:8]), a[1:4]), (quat_to_rot(b[4:8]), b[1:4]))
+        e_gt = reprojection(x_a, pb, ga, gb, K)
+        e_run = reprojection(x_a, pb, (quat_to_rot(a[4:8]), a[1:4]), (quat_to_rot(b[4:8]), b[1:4]),
+                             K)
         use = np.minimum(e_gt, e_run) < 15.0
         if use.sum() < 20:
             continue

@@ -50,6 +50,13 @@ def standing_share(seq, run):
     return out
 
 
+def draw_legend(img, entries, left, top):
+    """(label, BGR colour) entries, one a line, top left of the plot area."""
+    for i, (label, colour) in enumerate(entries):
+        cv2.rectangle(img, (left + 10, top + 2 + 18 * i), (left + 24, top + 12 + 18 * i), colour, -1)
+        cv2.putText(img, label, (left + 30, top + 12 + 18 * i), 0, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
+
+
 def plot(path, t0, series, bars):
     w, h, left, top = 1000, 360, 60, 30
     img = np.full((h, w, 3), 255, np.uint8)
@@ -71,11 +78,8 @@ def plot(path, t0, series, bars):
     for label, s, colour in series:
         pts = [xy(t, s[t][0]) for t in sorted(s)]
         cv2.polylines(img, [np.array(pts, np.int32)], False, colour, 1, cv2.LINE_AA)
-    legend = [(l, c) for l, _, c in series] + ([("standing person masked (share)", (200, 200, 200))]
-                                                 if bars else [])
-    for i, (label, colour) in enumerate(legend):
-        cv2.rectangle(img, (left + 10, top + 2 + 18 * i), (left + 24, top + 12 + 18 * i), colour, -1)
-        cv2.putText(img, label, (left + 30, top + 12 + 18 * i), 0, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
+    draw_legend(img, [(l, c) for l, _, c in series] +
+                ([("standing person masked (share)", (200, 200, 200))] if bars else []), left, top)
     cv2.putText(img, "rotation of each frame-to-frame motion minus the ground truth's [deg]; "
                 "time [s]", (left, h - 12), 0, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.imwrite(path, img)
