@@ -6,6 +6,7 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/core/dynamic/depthwise_conv_layer.hpp"
 #include "dynamap/core/dynamic/object_detector.hpp"
 
 namespace dynamap {
@@ -81,8 +82,16 @@ class DarknetDetector : public NetDetector {
     requireFile(o.model_cfg, "Darknet cfg");
     requireFile(o.model_weights, "Darknet weights");
     // The size check comes before the probe: a net with uninitialised weights is never run.
-    load([&] { return cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights); },
-         o.model_cfg + " / " + o.model_weights, [&] { checkWeightsSize(o.model_weights); });
+    // Its layers are made while the faster depthwise convolutions are registered
+    // (depthwise_conv_layer.hpp: same outputs, bit for bit).
+    load(
+        [&] {
+          ScopedDepthwiseConvLayers own_depthwise;
+          cv::dnn::Net net = cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights);
+          for (const auto& name : net.getLayerNames()) net.getLayer(net.getLayerId(name));
+          return net;
+        },
+        o.model_cfg + " / " + o.model_weights, [&] { checkWeightsSize(o.model_weights); });
   }
 
  protected:
