@@ -6,8 +6,8 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "dynamap/core/dynamic/depthwise_conv_layer.hpp"
 #include "dynamap/core/dynamic/object_detector.hpp"
+#include "dynamap/core/dynamic/own_conv_layers.hpp"
 
 namespace dynamap {
 
@@ -82,11 +82,11 @@ class DarknetDetector : public NetDetector {
     requireFile(o.model_cfg, "Darknet cfg");
     requireFile(o.model_weights, "Darknet weights");
     // The size check comes before the probe: a net with uninitialised weights is never run.
-    // Its layers are made while the faster depthwise convolutions are registered
-    // (depthwise_conv_layer.hpp: same outputs, bit for bit).
+    // Its layers are made while the faster convolutions are registered
+    // (own_conv_layers.hpp: same outputs, bit for bit).
     load(
         [&] {
-          ScopedDepthwiseConvLayers own_depthwise;
+          ScopedOwnConvLayers own_convolutions;
           cv::dnn::Net net = cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights);
           for (const auto& name : net.getLayerNames()) net.getLayer(net.getLayerId(name));
           return net;

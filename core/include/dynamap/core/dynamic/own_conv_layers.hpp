@@ -1,0 +1,40 @@
+#pragma once
+
+#include <mutex>
+
+#include <opencv2/dnn.hpp>
+
+namespace dynamap {
+
+/// OpenCV 4.6 runs some convolutions through a generic path (im2row, then dot products) that
+/// is slow for the shapes of a small detector: depthwise convolutions on planes under 18 pixels
+/// wide or with 5 x 5 kernels (about 1 GMAC/s; a 256 x 256 Yolo-Fastest's 16 x 16 and 8 x 8
+/// stages) and the 1 x 1 convolutions. This layer runs those cases with its own kernels
+/// (conv_kernels.hpp): OpenCV's arithmetic in OpenCV's order, so its outputs are bit for bit
+/// those of OpenCV's layer and the detector's boxes, masks and poses do not change. Every other
+/// case (another path, activation, CPU or layout) runs OpenCV's layer, which it wraps and keeps
+/// fused alike. Depthwise and 1 x 1 layers get this layer; the others are OpenCV's own.
+cv::Ptr<cv::dnn::Layer> createConvolutionLayer(cv::dnn::LayerParams& params);
+
+/// True if `layer` came from createConvolutionLayer as one of these layers.
+bool isOwnConvLayer(const cv::Ptr<cv::dnn::Layer>& layer);
+
+/// True if `layer` (finalised and fused in its net) runs its own kernel on a float input of this
+/// shape, false if it hands it to OpenCV's layer (or is not one of these layers).
+bool runsOwnConvKernel(const cv::Ptr<cv::dnn::Layer>& layer, const cv::dnn::MatShape& input);
+
+/// While alive, "Convolution" layers that OpenCV DNN instantiates come from
+/// createConvolutionLayer. OpenCV's layer registry is process-wide: the scopes are serialised,
+/// and a net read inside one must have its layers instantiated (Net::getLayer) before it ends.
+class ScopedOwnConvLayers {
+ public:
+  ScopedOwnConvLayers();
+  ~ScopedOwnConvLayers();
+  ScopedOwnConvLayers(const ScopedOwnConvLayers&) = delete;
+  ScopedOwnConvLayers& operator=(const ScopedOwnConvLayers&) = delete;
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
+}  // namespace dynamap
