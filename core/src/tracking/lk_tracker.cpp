@@ -49,25 +49,35 @@ void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, max_iterations_,
                                   0.01);
   std::vector<std::uint8_t> fwd_status, bwd_status;
-  std::vector<float> err;
-  cv::calcOpticalFlowPyrLK(prev, cur, prev_px, cur_px, fwd_status, err, window_, max_level_,
-                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
-  std::vector<cv::Point2f> back_px = prev_px;
-  cv::calcOpticalFlowPyrLK(cur, prev, cur_px, back_px, bwd_status, err, window_, backward_max_level,
-                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  // No error output: OpenCV then skips a last (scalar) pass over each window. That pass only
+  // also fails points that end a window or more outside the image, which the bounds and
+  // forward-backward checks below fail anyway.
+  cv::calcOpticalFlowPyrLK(prev, cur, prev_px, cur_px, fwd_status, cv::noArray(), window_,
+                           max_level_, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  // The backward pass only for the points that passed forward inside the image: every point is
+  // tracked on its own, so the others' results do not change.
   const cv::Size size = cur.front().size();
-  const double fb2 = fb_threshold_px_ * fb_threshold_px_;
+  const auto inside = [&](const cv::Point2f& p) {
+    return !(p.x < 0.f || p.y < 0.f || p.x > static_cast<float>(size.width - 1) ||
+             p.y > static_cast<float>(size.height - 1));
+  };
+  std::vector<std::size_t> back_of;
+  std::vector<cv::Point2f> back_from, back_px;
   for (std::size_t i = 0; i < prev_px.size(); ++i) {
     all_cur_px[begin + i] = cur_px[i];
-    if (!fwd_status[i] || !bwd_status[i]) continue;
-    const cv::Point2f d = back_px[i] - prev_px[i];
-    if (d.dot(d) > fb2) continue;
-    const cv::Point2f& p = cur_px[i];
-    if (p.x < 0.f || p.y < 0.f || p.x > static_cast<float>(size.width - 1) ||
-        p.y > static_cast<float>(size.height - 1)) {
-      continue;
-    }
-    all_ok[begin + i] = 1;
+    if (!fwd_status[i] || !inside(cur_px[i])) continue;
+    back_of.push_back(i);
+    back_from.push_back(cur_px[i]);
+    back_px.push_back(prev_px[i]);
+  }
+  if (back_of.empty()) return;
+  cv::calcOpticalFlowPyrLK(cur, prev, back_from, back_px, bwd_status, cv::noArray(), window_,
+                           backward_max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  const double fb2 = fb_threshold_px_ * fb_threshold_px_;
+  for (std::size_t j = 0; j < back_of.size(); ++j) {
+    const std::size_t i = back_of[j];
+    const cv::Point2f d = back_px[j] - prev_px[i];
+    if (bwd_status[j] && !(d.dot(d) > fb2)) all_ok[begin + i] = 1;
   }
 }
 
