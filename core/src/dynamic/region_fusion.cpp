@@ -31,14 +31,17 @@ constexpr int kInPlaceMinSamples = 20;  ///< depth samples needed to call a clus
 /// (8-bit, roi's size, or empty): pixels read as 0, not the object's.
 constexpr double kContinuityM = 0.5;
 double depthMode(const cv::Mat& roi, double near_m, const cv::Mat& dropped = cv::Mat()) {
-  const auto value = [&](int y, int x) {
-    return !dropped.empty() && dropped.at<uchar>(y, x) != 0 ? 0.f : roi.at<float>(y, x);
+  const bool any_dropped = !dropped.empty();
+  const auto value = [&](const float* z_row, const uchar* dropped_row, int x) {
+    return any_dropped && dropped_row[x] != 0 ? 0.f : z_row[x];
   };
   std::vector<int> hist(kBins + 2, 0);
   int total = 0;
   for (int y = 0; y < roi.rows; y += 2) {
+    const float* z_row = roi.ptr<float>(y);
+    const uchar* dropped_row = any_dropped ? dropped.ptr<uchar>(y) : nullptr;
     for (int x = 0; x < roi.cols; x += 2) {
-      const float z = value(y, x);
+      const float z = value(z_row, dropped_row, x);
       const int b = static_cast<int>(z / kBinM);
       const bool near = near_m <= 0.0 || std::abs(z - near_m) < kContinuityM;
       if (z > 0.f && b < kBins && near) {
@@ -56,8 +59,10 @@ double depthMode(const cv::Mat& roi, double near_m, const cv::Mat& dropped = cv:
   const double lo = (best - 2) * kBinM, hi = (best + 1) * kBinM;  // the peak bin +- one bin
   std::vector<float> vals;
   for (int y = 0; y < roi.rows; y += 2) {
+    const float* z_row = roi.ptr<float>(y);
+    const uchar* dropped_row = any_dropped ? dropped.ptr<uchar>(y) : nullptr;
     for (int x = 0; x < roi.cols; x += 2) {
-      const float z = value(y, x);
+      const float z = value(z_row, dropped_row, x);
       if (z > lo && z < hi) vals.push_back(z);
     }
   }
@@ -167,12 +172,18 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
   }
   if (depth_mode_m != nullptr) *depth_mode_m = mode;
   const auto lo = static_cast<float>(mode - band_m), hi = static_cast<float>(mode + band_m);
-  cv::Mat sel = (z > lo) & (z < hi);  // compared as float
-  if (!dropped.empty()) {             // a dropped pixel is selected as depth 0 would be
-    if (0.f > lo && 0.f < hi) {
-      sel |= dropped;
-    } else {
-      sel &= ~dropped;
+  // Depth within the band, compared as float, in one pass; a dropped pixel is selected as depth
+  // 0 would be.
+  const uchar dropped_sel = (0.f > lo && 0.f < hi) ? 255 : 0;
+  cv::Mat sel(z.size(), CV_8UC1);
+  for (int y = 0; y < z.rows; ++y) {
+    const float* z_row = z.ptr<float>(y);
+    const uchar* dropped_row = dropped.empty() ? nullptr : dropped.ptr<uchar>(y);
+    uchar* sel_row = sel.ptr<uchar>(y);
+    for (int x = 0; x < z.cols; ++x) {
+      sel_row[x] = (dropped_row != nullptr && dropped_row[x] != 0) ? dropped_sel
+                   : (z_row[x] > lo && z_row[x] < hi)              ? 255
+                                                                   : 0;
     }
   }
   cv::morphologyEx(sel, sel, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
