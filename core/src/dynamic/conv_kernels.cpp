@@ -150,7 +150,9 @@ bool openCvBuiltFor(const std::string& feature) {
 }  // namespace
 
 bool cpuHasAvx2Fma() {
-  static const bool has = cv::checkHardwareSupport(CV_CPU_AVX2) &&
+  // The kernels follow OpenCV 4.6's generic convolution path (4.7 replaced it).
+  static const bool has = cv::getVersionMajor() == 4 && cv::getVersionMinor() == 6 &&
+                          cv::checkHardwareSupport(CV_CPU_AVX2) &&
                           cv::checkHardwareSupport(CV_CPU_FMA3) && openCvBuiltFor("AVX2");
   return has;
 }

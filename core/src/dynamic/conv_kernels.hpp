@@ -7,8 +7,9 @@ namespace dynamap::conv {
 /// Kernels that compute what OpenCV 4.6's generic convolution path computes (im2row, then its
 /// fastConv dot products), bit for bit, faster: each output is summed in OpenCV's order (its
 /// lanes of fused multiply-adds, its pairwise sum of the lanes, bias + sum, leaky ReLU) while the
-/// vector lanes here hold neighbouring output pixels. Callers check first that the CPU has the
-/// instructions and that OpenCV was built for them (its variant of that name then runs).
+/// vector lanes here hold neighbouring output pixels. Callers check first that OpenCV is 4.6,
+/// that the CPU has the instructions and that OpenCV was built for them (its variant of that
+/// name then runs).
 bool cpuHasAvx2Fma();
 bool cpuHasAvx512();
 
