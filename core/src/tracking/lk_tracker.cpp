@@ -5,7 +5,24 @@
 
 #include <opencv2/video/tracking.hpp>
 
+#include "dynamap/core/tracking/own_pyr_lk.hpp"
+
 namespace dynamap {
+namespace {
+
+/// OpenCV's pyramidal LK with initial flow, or its bit-for-bit twin where that runs here.
+void pyramidalLk(const LkPyramid& from, const LkPyramid& to, const std::vector<cv::Point2f>& px,
+                 std::vector<cv::Point2f>& tracked, std::vector<std::uint8_t>& status,
+                 cv::Size window, int max_level, const cv::TermCriteria& criteria) {
+  if (lk::ownPyrLkUsable(window)) {
+    lk::ownPyrLk(from, to, px, tracked, status, window, max_level, criteria);
+  } else {
+    cv::calcOpticalFlowPyrLK(from, to, px, tracked, status, cv::noArray(), window, max_level,
+                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  }
+}
+
+}  // namespace
 
 LkTracker::LkTracker(const TrackerConfig& config)
     : window_(config.lk_window_px, config.lk_window_px),
@@ -52,8 +69,7 @@ void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
   // No error output: OpenCV then skips a last (scalar) pass over each window. That pass only
   // also fails points that end a window or more outside the image, which the bounds and
   // forward-backward checks below fail anyway.
-  cv::calcOpticalFlowPyrLK(prev, cur, prev_px, cur_px, fwd_status, cv::noArray(), window_,
-                           max_level_, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  pyramidalLk(prev, cur, prev_px, cur_px, fwd_status, window_, max_level_, criteria);
   // The backward pass only for the points that passed forward inside the image: every point is
   // tracked on its own, so the others' results do not change.
   const cv::Size size = cur.front().size();
@@ -71,8 +87,7 @@ void LkTracker::trackRange(const LkPyramid& prev, const LkPyramid& cur,
     back_px.push_back(prev_px[i]);
   }
   if (back_of.empty()) return;
-  cv::calcOpticalFlowPyrLK(cur, prev, back_from, back_px, bwd_status, cv::noArray(), window_,
-                           backward_max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  pyramidalLk(cur, prev, back_from, back_px, bwd_status, window_, backward_max_level, criteria);
   const double fb2 = fb_threshold_px_ * fb_threshold_px_;
   for (std::size_t j = 0; j < back_of.size(); ++j) {
     const std::size_t i = back_of[j];
