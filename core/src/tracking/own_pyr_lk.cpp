@@ -207,9 +207,9 @@ __attribute__((target("avx2"))) void mismatch(const cv::Mat& image, int x0, int 
 }
 
 /// One level for one point, as OpenCV's LKTrackerInvoker.
-void trackPoint(const cv::Mat& I, const cv::Mat& derivI, const cv::Mat& J, cv::Point2f prev_pt,
-                cv::Point2f& next_out, std::uint8_t& status, cv::Size win_size, int level,
-                int max_level, int max_count, double epsilon, Window& win) {
+void trackPoint(const cv::Mat& first, const cv::Mat& deriv, const cv::Mat& second,
+                cv::Point2f prev_pt, cv::Point2f& next_out, std::uint8_t& status, cv::Size win_size,
+                int level, int max_level, int max_count, double epsilon, Window& win) {
   const cv::Point2f half_win((win_size.width - 1) * 0.5f, (win_size.height - 1) * 0.5f);
   cv::Point2f prev = prev_pt * static_cast<float>(1. / (1 << level));
   cv::Point2f next =
@@ -217,41 +217,41 @@ void trackPoint(const cv::Mat& I, const cv::Mat& derivI, const cv::Mat& J, cv::P
   next_out = next;
   prev -= half_win;
   const cv::Point2i iprev(cvFloor(prev.x), cvFloor(prev.y));
-  if (iprev.x < -win_size.width || iprev.x >= derivI.cols || iprev.y < -win_size.height ||
-      iprev.y >= derivI.rows) {
+  if (iprev.x < -win_size.width || iprev.x >= deriv.cols || iprev.y < -win_size.height ||
+      iprev.y >= deriv.rows) {
     if (level == 0) status = 0;
     return;
   }
   float a11 = 0.f, a12 = 0.f, a22 = 0.f;
-  readWindow(I, derivI, iprev.x, iprev.y,
+  readWindow(first, deriv, iprev.x, iprev.y,
              weightsAt(prev.x - static_cast<float>(iprev.x), prev.y - static_cast<float>(iprev.y)),
              win, a11, a12, a22);
-  const float A11 = a11 * kFltScale, A12 = a12 * kFltScale, A22 = a22 * kFltScale;
-  float D = A11 * A22 - A12 * A12;
-  const float min_eig = (A22 + A11 - std::sqrt((A11 - A22) * (A11 - A22) + 4.f * A12 * A12)) /
+  const float g11 = a11 * kFltScale, g12 = a12 * kFltScale, g22 = a22 * kFltScale;
+  const float det = g11 * g22 - g12 * g12;
+  const float min_eig = (g22 + g11 - std::sqrt((g11 - g22) * (g11 - g22) + 4.f * g12 * g12)) /
                         static_cast<float>(2 * win_size.width * win_size.height);
-  if (min_eig < kMinEigThreshold || D < FLT_EPSILON) {
+  if (min_eig < kMinEigThreshold || det < FLT_EPSILON) {
     if (level == 0) status = 0;
     return;
   }
-  D = 1.f / D;
+  const float inv_det = 1.f / det;
   next -= half_win;
   cv::Point2f prev_delta;
   for (int j = 0; j < max_count; ++j) {
     const cv::Point2i inext(cvFloor(next.x), cvFloor(next.y));
-    if (inext.x < -win_size.width || inext.x >= J.cols || inext.y < -win_size.height ||
-        inext.y >= J.rows) {
+    if (inext.x < -win_size.width || inext.x >= second.cols || inext.y < -win_size.height ||
+        inext.y >= second.rows) {
       if (level == 0) status = 0;
       break;
     }
     float b1 = 0.f, b2 = 0.f;
-    mismatch(J, inext.x, inext.y,
+    mismatch(second, inext.x, inext.y,
              weightsAt(next.x - static_cast<float>(inext.x), next.y - static_cast<float>(inext.y)),
              win, b1, b2);
     b1 *= kFltScale;
     b2 *= kFltScale;
-    const cv::Point2f delta(static_cast<float>((A12 * b2 - A22 * b1) * D),
-                            static_cast<float>((A12 * b1 - A11 * b2) * D));
+    const cv::Point2f delta(static_cast<float>((g12 * b2 - g22 * b1) * inv_det),
+                            static_cast<float>((g12 * b1 - g11 * b2) * inv_det));
     next += delta;
     next_out = next + half_win;
     if (delta.ddot(delta) <= epsilon) break;
@@ -305,13 +305,13 @@ void ownPyrLk(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& next
   epsilon *= epsilon;
   Window win(static_cast<std::size_t>(window.height));
   for (int level = top; level >= 0; --level) {
-    const cv::Mat& I = prev[static_cast<std::size_t>(level) * 2];
-    const cv::Mat& derivI = prev[static_cast<std::size_t>(level) * 2 + 1];
-    const cv::Mat& J = next[static_cast<std::size_t>(level) * 2];
-    CV_Assert(I.size() == J.size() && I.type() == J.type());
+    const cv::Mat& first = prev[static_cast<std::size_t>(level) * 2];
+    const cv::Mat& deriv = prev[static_cast<std::size_t>(level) * 2 + 1];
+    const cv::Mat& second = next[static_cast<std::size_t>(level) * 2];
+    CV_Assert(first.size() == second.size() && first.type() == second.type());
     for (std::size_t i = 0; i < prev_px.size(); ++i) {
-      trackPoint(I, derivI, J, prev_px[i], next_px[i], status[i], window, level, top, max_count,
-                 epsilon, win);
+      trackPoint(first, deriv, second, prev_px[i], next_px[i], status[i], window, level, top,
+                 max_count, epsilon, win);
     }
   }
 }
