@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/video/tracking.hpp>
 
 // This file is compiled with -ffp-contract=off (core/CMakeLists.txt): OpenCV's LK multiplies
 // and adds in separate roundings (its SSE2 build has no FMA), and so must every line here.
@@ -56,49 +55,41 @@ __attribute__((target("avx2"))) Pair pairOf(const Weights& w) {
   return {_mm256_set1_epi32(top), _mm256_set1_epi32(bottom)};
 }
 
-/// Bilinear value of 16 neighbouring pixels of an 8-bit row pair, descaled by `shift` as OpenCV
-/// does: (w00 a + w01 b + w10 c + w11 d + half) >> shift, packed to int16. Reads 16 bytes of each
-/// row (pixel 15's right neighbour is taken as 0: that pixel is not used).
-__attribute__((target("avx2"))) inline __m256i bilinearU8(const std::uint8_t* top,
-                                                          const std::uint8_t* bottom, const Pair& w,
-                                                          __m256i half, int shift) {
-  const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(top));
-  const __m128i u = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bottom));
-  const __m256i a = _mm256_cvtepu8_epi16(t), b = _mm256_cvtepu8_epi16(_mm_srli_si128(t, 1));
-  const __m256i c = _mm256_cvtepu8_epi16(u), d = _mm256_cvtepu8_epi16(_mm_srli_si128(u, 1));
-  const __m128i count = _mm_cvtsi32_si128(shift);
-  const __m256i lo = _mm256_sra_epi32(
+/// OpenCV's bilinear step on int16 lanes: per pixel (w00 a + w01 b + w10 c + w11 d + half) >>
+/// kShift, with a, b the pixel and its right neighbour in the top row, c, d in the bottom row;
+/// packed back to int16 in the lanes' order.
+template <int kShift>
+__attribute__((target("avx2"))) inline __m256i bilinear(__m256i a, __m256i b, __m256i c, __m256i d,
+                                                        const Pair& w) {
+  const __m256i half = _mm256_set1_epi32(1 << (kShift - 1));
+  const __m256i lo = _mm256_srai_epi32(
       _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(a, b), w.w0), half),
                        _mm256_madd_epi16(_mm256_unpacklo_epi16(c, d), w.w1)),
-      count);
-  const __m256i hi = _mm256_sra_epi32(
+      kShift);
+  const __m256i hi = _mm256_srai_epi32(
       _mm256_add_epi32(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(a, b), w.w0), half),
                        _mm256_madd_epi16(_mm256_unpackhi_epi16(c, d), w.w1)),
-      count);
-  return _mm256_packs_epi32(lo, hi);  // pixels 0..15 in order
+      kShift);
+  return _mm256_packs_epi32(lo, hi);
+}
+
+/// Bilinear value (scaled by 32, as OpenCV keeps it) of 16 neighbouring pixels of an 8-bit row
+/// pair. Reads 16 bytes of each row (pixel 15's right neighbour is taken as 0: that pixel is not
+/// used).
+__attribute__((target("avx2"))) inline __m256i bilinearU8(const std::uint8_t* top,
+                                                          const std::uint8_t* bottom,
+                                                          const Pair& w) {
+  const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(top));
+  const __m128i u = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bottom));
+  return bilinear<kWBits - 5>(_mm256_cvtepu8_epi16(t), _mm256_cvtepu8_epi16(_mm_srli_si128(t, 1)),
+                              _mm256_cvtepu8_epi16(u), _mm256_cvtepu8_epi16(_mm_srli_si128(u, 1)),
+                              w);  // pixels 0..15 in order
 }
 
 /// (Ix, Iy) pairs of 8 pixels and the same shifted by one pixel (the next register's first
 /// pixel, or 0 after the last).
 __attribute__((target("avx2"))) inline __m256i nextPixel(__m256i v, __m256i after) {
   return _mm256_alignr_epi8(_mm256_permute2x128_si256(v, after, 0x21), v, 4);
-}
-
-/// Bilinear (Ix, Iy) of 8 pixels from two rows of interleaved derivatives, OpenCV's rounding.
-__attribute__((target("avx2"))) inline __m256i bilinearDeriv(__m256i a, __m256i a_next, __m256i c,
-                                                             __m256i c_next, const Pair& w) {
-  const __m256i half = _mm256_set1_epi32(1 << (kWBits - 1));
-  const __m256i lo = _mm256_srai_epi32(
-      _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(a, a_next), w.w0), half),
-          _mm256_madd_epi16(_mm256_unpacklo_epi16(c, c_next), w.w1)),
-      kWBits);
-  const __m256i hi = _mm256_srai_epi32(
-      _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(a, a_next), w.w0), half),
-          _mm256_madd_epi16(_mm256_unpackhi_epi16(c, c_next), w.w1)),
-      kWBits);
-  return _mm256_packs_epi32(lo, hi);  // Ix0 Iy0 Ix1 Iy1 ... of the 8 pixels, in order
 }
 
 __attribute__((target("avx2"))) inline __m256i lowShort(__m256i v) {
@@ -117,7 +108,6 @@ __attribute__((target("avx2"))) void readWindow(const cv::Mat& image, const cv::
                                                 int y0, const Weights& weights, Window& win,
                                                 float& a11, float& a12, float& a22) {
   const Pair w = pairOf(weights);
-  const __m256i half = _mm256_set1_epi32(1 << (kWBits - 5 - 1));
   const auto rows = static_cast<int>(win.size());
   __m128 q11 = _mm_setzero_ps(), q12 = _mm_setzero_ps(), q22 = _mm_setzero_ps();
   float s11 = 0.f, s12 = 0.f, s22 = 0.f;
@@ -125,15 +115,16 @@ __attribute__((target("avx2"))) void readWindow(const cv::Mat& image, const cv::
   const __m256i zero = _mm256_setzero_si256();
   for (int y = 0; y < rows; ++y) {
     const std::uint8_t* src = rowOf(image, y0 + y) + x0;
-    win[y].value = bilinearU8(src, src + image.step[0], w, half, kWBits - 5);
+    win[y].value = bilinearU8(src, src + image.step[0], w);
     const auto* d = reinterpret_cast<const Deriv*>(rowOf(deriv, y0 + y)) + 2 * x0;
     const auto* e = reinterpret_cast<const Deriv*>(rowOf(deriv, y0 + y + 1)) + 2 * x0;
     const __m256i a0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d));
     const __m256i a1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d + 16));
     const __m256i c0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(e));
     const __m256i c1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(e + 16));
-    const __m256i d0 = bilinearDeriv(a0, nextPixel(a0, a1), c0, nextPixel(c0, c1), w);
-    const __m256i d1 = bilinearDeriv(a1, nextPixel(a1, zero), c1, nextPixel(c1, zero), w);
+    const __m256i d0 =
+        bilinear<kWBits>(a0, nextPixel(a0, a1), c0, nextPixel(c0, c1), w);  // Ix0 Iy0 ..
+    const __m256i d1 = bilinear<kWBits>(a1, nextPixel(a1, zero), c1, nextPixel(c1, zero), w);
     win[y].dx0 = lowShort(d0);
     win[y].dy0 = _mm256_srai_epi32(d0, 16);
     win[y].dx1 = lowShort(d1);
@@ -173,15 +164,13 @@ __attribute__((target("avx2"))) void mismatch(const cv::Mat& image, int x0, int 
                                               const Weights& weights, const Window& win, float& b1,
                                               float& b2) {
   const Pair w = pairOf(weights);
-  const __m256i half = _mm256_set1_epi32(1 << (kWBits - 5 - 1));
   const auto rows = static_cast<int>(win.size());
   __m256 qb = _mm256_setzero_ps();  // OpenCV's qb0 | qb1
   float s1 = 0.f, s2 = 0.f;
   alignas(32) float t1[8], t2[8];
   for (int y = 0; y < rows; ++y) {
     const std::uint8_t* src = rowOf(image, y0 + y) + x0;
-    const __m256i diff =
-        _mm256_subs_epi16(bilinearU8(src, src + image.step[0], w, half, kWBits - 5), win[y].value);
+    const __m256i diff = _mm256_subs_epi16(bilinearU8(src, src + image.step[0], w), win[y].value);
     const __m256i it0 = _mm256_cvtepi16_epi32(_mm256_castsi256_si128(diff));
     const __m256i it1 = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(diff, 1));
     // Pixels 0..7: OpenCV's lanes hold pixel pairs (0, 4), (1, 5) in qb0, (2, 6), (3, 7) in qb1.
