@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 
 from motion_vs_gt import draw_legend, standing_share
+from tum_lists import read_list
 
 ORB = cv2.ORB_create(1500)
 
@@ -65,12 +66,7 @@ def gt_pose(gt, t):
 
 
 def listing(seq, name):
-    out = []
-    for line in open(os.path.join(seq, name)):
-        if line.strip() and not line.startswith("#"):
-            t, f = line.split()[:2]
-            out.append((float(t), os.path.join(seq, f)))
-    return out
+    return [(t, os.path.join(seq, f)) for t, f in read_list(seq, name)]
 
 
 def nearest(items, t, max_dt=0.02):

@@ -18,14 +18,11 @@ import sys
 import cv2
 import numpy as np
 
+from tum_lists import read_list
+
 
 def stamps_to_files(seq, listing):
-    out = {}
-    for line in open(os.path.join(seq, listing)):
-        if not line.startswith("#") and line.strip():
-            t, f = line.split()[:2]
-            out[float(t)] = f
-    return out
+    return dict(read_list(seq, listing))
 
 
 def nearest(table, t):

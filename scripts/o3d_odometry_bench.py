@@ -17,18 +17,9 @@ import time
 import numpy as np
 import open3d as o3d
 
+from tum_lists import read_list
+
 FX, FY, CX, CY = 535.4, 539.2, 320.1, 247.6
-
-
-def read_list(path):
-    out = []
-    with open(path) as f:
-        for line in f:
-            parts = line.replace(",", " ").split()
-            if not parts or parts[0].startswith("#"):
-                continue
-            out.append((float(parts[0]), parts[1]))
-    return out
 
 
 def associate(rgb, depth, max_diff=0.02):
@@ -58,7 +49,7 @@ def main():
         sys.exit(__doc__)
     seq, term, out = sys.argv[1], sys.argv[2], sys.argv[3]
     limit = int(sys.argv[4]) if len(sys.argv) > 4 else None
-    frames = associate(read_list(seq + "/rgb.txt"), read_list(seq + "/depth.txt"))[:limit]
+    frames = associate(read_list(seq, "rgb.txt"), read_list(seq, "depth.txt"))[:limit]
     intr = o3d.camera.PinholeCameraIntrinsic(640, 480, FX, FY, CX, CY)
     jac = (o3d.pipelines.odometry.RGBDOdometryJacobianFromColorTerm() if term == "color" else
            o3d.pipelines.odometry.RGBDOdometryJacobianFromHybridTerm())
