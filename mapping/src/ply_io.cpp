@@ -12,28 +12,15 @@
 #include <sstream>
 
 #include "dynamap/mapping/map_backend.hpp"
+#include "dynamap/mapping/ply_header.hpp"
 
 namespace dynamap {
 namespace {
 
-struct Property {
-  std::string name;
-  std::string type;        // scalar type, or the list's item type
-  std::string count_type;  // non-empty for list properties
-};
-struct Element {
-  std::string name;
-  std::size_t count = 0;
-  std::vector<Property> props;
-};
-
 std::size_t typeSize(const std::string& t, const std::string& path) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
-    return 4;
-  if (t == "double" || t == "float64") return 8;
-  throw MappingError(path + ": unknown PLY type '" + t + "'");
+  const std::size_t size = plyScalarSize(t);
+  if (size == 0) throw MappingError(path + ": unknown PLY type '" + t + "'");
+  return size;
 }
 
 // Decodes one little-endian scalar of PLY type t at p.
@@ -68,59 +55,49 @@ std::uint8_t toByte(double v) {
   return v < 255.0 ? static_cast<std::uint8_t>(v) : std::uint8_t{255};
 }
 
-double readBinary(std::istream& in, const std::string& t, const std::string& path) {
-  char buf[8];
-  if (!in.read(buf, static_cast<std::streamsize>(typeSize(t, path)))) {
-    throw MappingError(path + ": truncated PLY data");
+// Reads one value of the data section, ASCII or binary.
+struct ValueReader {
+  std::istream& in;
+  const std::string& path;
+  bool binary;
+
+  double next(const std::string& type) {
+    if (binary) {
+      char buf[8];
+      if (!in.read(buf, static_cast<std::streamsize>(typeSize(type, path)))) {
+        throw MappingError(path + ": truncated PLY data");
+      }
+      return decode(buf, type);
+    }
+    double v = 0.0;
+    if (!(in >> v)) throw MappingError(path + ": truncated PLY data");
+    return v;
   }
-  return decode(buf, t);
+};
+
+// Property indices of x, y, z, red, green, blue in an element (-1 when absent).
+using FieldIndices = std::array<int, 6>;
+
+FieldIndices fieldIndices(const PlyElement& e) {
+  FieldIndices idx = {-1, -1, -1, -1, -1, -1};
+  for (std::size_t k = 0; k < e.props.size(); ++k) {
+    const std::string& n = e.props[k].name;
+    const int ki = static_cast<int>(k);
+    if (n == "x") idx[0] = ki;
+    if (n == "y") idx[1] = ki;
+    if (n == "z") idx[2] = ki;
+    if (n == "red" || n == "r") idx[3] = ki;
+    if (n == "green" || n == "g") idx[4] = ki;
+    if (n == "blue" || n == "b") idx[5] = ki;
+  }
+  return idx;
 }
 
-std::vector<Element> readHeader(std::istream& in, const std::string& path, bool* binary) {
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
-    throw MappingError(path + ": not a PLY file");
-  }
-  std::vector<Element> elements;
-  *binary = false;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream ls(line);
-    std::string word;
-    ls >> word;
-    if (word == "format") {
-      std::string fmt;
-      ls >> fmt;
-      if (fmt == "binary_little_endian") {
-        *binary = true;
-      } else if (fmt != "ascii") {
-        throw MappingError(path + ": unsupported PLY format '" + fmt + "'");
-      }
-    } else if (word == "element") {
-      Element e;
-      ls >> e.name >> e.count;
-      elements.push_back(e);
-    } else if (word == "property" && !elements.empty()) {
-      Property p;
-      std::string t;
-      ls >> t;
-      if (t == "list") {
-        ls >> p.count_type >> p.type >> p.name;
-      } else {
-        p.type = t;
-        ls >> p.name;
-      }
-      elements.back().props.push_back(p);
-    } else if (word == "end_header") {
-      return elements;
-    }
-  }
-  throw MappingError(path + ": PLY header without end_header");
-}
+bool hasColours(const FieldIndices& idx) { return idx[3] >= 0 && idx[4] >= 0 && idx[5] >= 0; }
 
 // Binary vertices without list properties: read the whole block, decode by byte offsets.
-bool readFixedVertices(std::istream& in, const Element& e, const std::string& path,
-                       const std::array<int, 6>& idx, PlyData* data) {
+bool readFixedVertices(std::istream& in, const PlyElement& e, const std::string& path,
+                       const FieldIndices& idx, PlyData* data) {
   std::vector<std::size_t> offset(e.props.size());
   std::size_t stride = 0;
   for (std::size_t k = 0; k < e.props.size(); ++k) {
@@ -139,7 +116,7 @@ bool readFixedVertices(std::istream& in, const Element& e, const std::string& pa
     const auto ku = static_cast<std::size_t>(k);
     return decode(rec + offset[ku], e.props[ku].type);
   };
-  const bool colours = idx[3] >= 0 && idx[4] >= 0 && idx[5] >= 0;
+  const bool colours = hasColours(idx);
   for (std::size_t i = 0; i < e.count; ++i) {
     const char* rec = block.data() + i * stride;
     data->vertices.emplace_back(value(rec, idx[0]), value(rec, idx[1]), value(rec, idx[2]));
@@ -151,36 +128,136 @@ bool readFixedVertices(std::istream& in, const Element& e, const std::string& pa
   return true;
 }
 
+// Reads one list property's items into `list`; a length above `available` bytes is corrupt.
+void readList(ValueReader& reader, const PlyProperty& p, std::uintmax_t available,
+              std::vector<double>* list) {
+  const double n = reader.next(p.count_type);
+  if (!(n >= 0.0 && n <= static_cast<double>(available))) {
+    throw MappingError(reader.path + ": bad PLY list length " + std::to_string(n));
+  }
+  list->resize(static_cast<std::size_t>(n));
+  for (double& v : *list) v = reader.next(p.type);
+}
+
+// Fan-triangulates one face's polygon (vertex indices in `list`) into data->triangles.
+void addFace(const std::vector<double>& list, const std::string& path, PlyData* data) {
+  for (const double v : list) {
+    if (!(v >= 0.0 && v < 4294967296.0)) {
+      throw MappingError(path + ": bad PLY face index " + std::to_string(v));
+    }
+  }
+  for (std::size_t t = 1; t + 1 < list.size(); ++t) {
+    data->triangles.push_back({static_cast<std::uint32_t>(list[0]),
+                               static_cast<std::uint32_t>(list[t]),
+                               static_cast<std::uint32_t>(list[t + 1])});
+  }
+}
+
+// Reads element `e` value by value (ASCII, list properties, any non-vertex element): vertices
+// (and colours) of a vertex element, triangles of a face element when `is_face`.
+void readElementValues(ValueReader& reader, const PlyElement& e, bool is_face,
+                       std::uintmax_t available, PlyData* data) {
+  const bool is_vertex = e.name == "vertex";
+  const FieldIndices idx = fieldIndices(e);
+  const bool colours = is_vertex && hasColours(idx);
+  std::vector<double> values(e.props.size());
+  std::vector<double> list;
+  for (std::size_t i = 0; i < e.count; ++i) {
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      const PlyProperty& p = e.props[k];
+      if (p.count_type.empty()) {
+        values[k] = reader.next(p.type);
+        continue;
+      }
+      readList(reader, p, available, &list);
+      if (is_face) addFace(list, reader.path, data);
+    }
+    if (!is_vertex) continue;
+    const auto at = [&values, &idx](int a) { return values[static_cast<std::size_t>(idx[a])]; };
+    data->vertices.emplace_back(at(0), at(1), at(2));
+    if (colours) data->colors.push_back({toByte(at(3)), toByte(at(4)), toByte(at(5))});
+  }
+}
+
+void checkFaceIndices(const PlyData& data, const std::string& path) {
+  for (const auto& t : data.triangles) {
+    if (t[0] >= data.vertices.size() || t[1] >= data.vertices.size() ||
+        t[2] >= data.vertices.size()) {
+      throw MappingError(path + ": PLY face index out of range (" +
+                         std::to_string(data.vertices.size()) + " vertices)");
+    }
+  }
+}
+
 }  // namespace
+
+std::size_t plyScalarSize(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
+    return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+PlyHeader readPlyHeader(std::istream& in, const std::string& path) {
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
+    throw MappingError(path + ": not a PLY file");
+  }
+  PlyHeader header;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream ls(line);
+    std::string word;
+    ls >> word;
+    if (word == "format") {
+      std::string fmt;
+      ls >> fmt;
+      if (fmt == "binary_little_endian") {
+        header.binary = true;
+      } else if (fmt != "ascii") {
+        throw MappingError(path + ": unsupported PLY format '" + fmt + "'");
+      }
+    } else if (word == "element") {
+      PlyElement e;
+      ls >> e.name >> e.count;
+      header.elements.push_back(e);
+    } else if (word == "property" && !header.elements.empty()) {
+      PlyProperty p;
+      std::string t;
+      ls >> t;
+      if (t == "list") {
+        ls >> p.count_type >> p.type >> p.name;
+      } else {
+        p.type = t;
+        ls >> p.name;
+      }
+      header.elements.back().props.push_back(p);
+    } else if (word == "end_header") {
+      return header;
+    }
+  }
+  throw MappingError(path + ": PLY header without end_header");
+}
 
 PlyData readPly(const std::string& path, bool with_faces) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw MappingError(path + ": cannot open PLY file");
-  bool binary = false;
-  const std::vector<Element> elements = readHeader(in, path, &binary);
-  PlyData data;
+  const PlyHeader header = readPlyHeader(in, path);
+  const std::vector<PlyElement>& elements = header.elements;
   if (std::count_if(elements.begin(), elements.end(),
-                    [](const Element& e) { return e.name == "vertex"; }) > 1) {
+                    [](const PlyElement& e) { return e.name == "vertex"; }) > 1) {
     throw MappingError(path + ": PLY file with more than one vertex element");
   }
-  for (const Element& e : elements) {
+  PlyData data;
+  ValueReader reader{in, path, header.binary};
+  for (const PlyElement& e : elements) {
     const bool is_vertex = e.name == "vertex";
-    const bool is_face = e.name == "face" && with_faces;
-    int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
-    for (std::size_t k = 0; k < e.props.size(); ++k) {
-      const std::string& n = e.props[k].name;
-      const int ki = static_cast<int>(k);
-      if (n == "x") ix = ki;
-      if (n == "y") iy = ki;
-      if (n == "z") iz = ki;
-      if (n == "red" || n == "r") ir = ki;
-      if (n == "green" || n == "g") ig = ki;
-      if (n == "blue" || n == "b") ib = ki;
-    }
-    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) {
+    const FieldIndices idx = fieldIndices(e);
+    if (is_vertex && (idx[0] < 0 || idx[1] < 0 || idx[2] < 0)) {
       throw MappingError(path + ": PLY vertices without x, y, z");
     }
-    const bool colours = is_vertex && ir >= 0 && ig >= 0 && ib >= 0;
     if (e.props.empty()) continue;  // no data in the file
     // Every element takes at least one byte: a larger count is a corrupt header.
     const std::uintmax_t available = remainingBytes(in);
@@ -189,67 +266,10 @@ PlyData readPly(const std::string& path, bool with_faces) {
                          " exceeds the file size");
     }
     if (is_vertex) data.vertices.reserve(e.count);
-    if (binary && is_vertex && readFixedVertices(in, e, path, {ix, iy, iz, ir, ig, ib}, &data)) {
-      continue;
-    }
-    std::vector<double> values(e.props.size());
-    std::vector<double> list;
-    for (std::size_t i = 0; i < e.count; ++i) {
-      for (std::size_t k = 0; k < e.props.size(); ++k) {
-        const Property& p = e.props[k];
-        if (p.count_type.empty()) {
-          if (binary) {
-            values[k] = readBinary(in, p.type, path);
-          } else if (!(in >> values[k])) {
-            throw MappingError(path + ": truncated PLY data");
-          }
-          continue;
-        }
-        double n = 0;
-        if (binary) {
-          n = readBinary(in, p.count_type, path);
-        } else if (!(in >> n)) {
-          throw MappingError(path + ": truncated PLY data");
-        }
-        if (!(n >= 0.0 && n <= static_cast<double>(available))) {
-          throw MappingError(path + ": bad PLY list length " + std::to_string(n));
-        }
-        list.resize(static_cast<std::size_t>(n));
-        for (double& v : list) {
-          if (binary) {
-            v = readBinary(in, p.type, path);
-          } else if (!(in >> v)) {
-            throw MappingError(path + ": truncated PLY data");
-          }
-        }
-        if (is_face) {
-          for (const double v : list) {
-            if (!(v >= 0.0 && v < 4294967296.0)) {
-              throw MappingError(path + ": bad PLY face index " + std::to_string(v));
-            }
-          }
-          for (std::size_t t = 1; t + 1 < list.size(); ++t) {  // fan-triangulate polygons
-            data.triangles.push_back({static_cast<std::uint32_t>(list[0]),
-                                      static_cast<std::uint32_t>(list[t]),
-                                      static_cast<std::uint32_t>(list[t + 1])});
-          }
-        }
-      }
-      if (is_vertex) {
-        data.vertices.emplace_back(values[ix], values[iy], values[iz]);
-        if (colours) {
-          data.colors.push_back({toByte(values[ir]), toByte(values[ig]), toByte(values[ib])});
-        }
-      }
-    }
+    if (header.binary && is_vertex && readFixedVertices(in, e, path, idx, &data)) continue;
+    readElementValues(reader, e, e.name == "face" && with_faces, available, &data);
   }
-  for (const auto& t : data.triangles) {
-    if (t[0] >= data.vertices.size() || t[1] >= data.vertices.size() ||
-        t[2] >= data.vertices.size()) {
-      throw MappingError(path + ": PLY face index out of range (" +
-                         std::to_string(data.vertices.size()) + " vertices)");
-    }
-  }
+  checkFaceIndices(data, path);
   return data;
 }
 

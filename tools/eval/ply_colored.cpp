@@ -4,66 +4,13 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
 
+#include "dynamap/mapping/ply_header.hpp"
+
 namespace dynamap {
 namespace {
-
-struct Prop {
-  std::string name, type, count_type;  // count_type non-empty for lists
-};
-struct Elem {
-  std::string name;
-  std::size_t count = 0;
-  std::vector<Prop> props;
-};
-struct Header {
-  bool binary_le = false;
-  std::vector<Elem> elements;
-};
-
-Header readHeader(std::istream& in, const std::string& path) {
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
-    throw std::runtime_error(path + ": not a PLY file");
-  }
-  Header h;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream ls(line);
-    std::string word;
-    ls >> word;
-    if (word == "format") {
-      std::string fmt;
-      ls >> fmt;
-      h.binary_le = fmt == "binary_little_endian";
-    } else if (word == "element") {
-      Elem e;
-      ls >> e.name >> e.count;
-      h.elements.push_back(e);
-    } else if (word == "property" && !h.elements.empty()) {
-      Prop p;
-      ls >> p.type;
-      if (p.type == "list") ls >> p.count_type >> p.type;
-      ls >> p.name;
-      h.elements.back().props.push_back(p);
-    } else if (word == "end_header") {
-      return h;
-    }
-  }
-  throw std::runtime_error(path + ": PLY header without end_header");
-}
-
-int scalarSize(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
-    return 4;
-  if (t == "double" || t == "float64") return 8;
-  return -1;
-}
 
 /// Byte layout of a fixed-size binary vertex record.
 struct VertexLayout {
@@ -73,14 +20,14 @@ struct VertexLayout {
   int rgb[3] = {-1, -1, -1};
 };
 
-bool vertexLayout(const Elem& e, VertexLayout* layout) {
+bool vertexLayout(const PlyElement& e, VertexLayout* layout) {
   std::size_t offset = 0;
   int xyz_size[3] = {0, 0, 0};
   const char* xyz_names[3] = {"x", "y", "z"};
   const char* rgb_names[3] = {"red", "green", "blue"};
-  for (const Prop& p : e.props) {
-    const int size = scalarSize(p.type);
-    if (!p.count_type.empty() || size < 0) return false;
+  for (const PlyProperty& p : e.props) {
+    const int size = static_cast<int>(plyScalarSize(p.type));
+    if (!p.count_type.empty() || size == 0) return false;
     for (int k = 0; k < 3; ++k) {
       if (p.name == xyz_names[k]) {
         if (p.type != "float" && p.type != "float32" && p.type != "double" && p.type != "float64")
@@ -130,13 +77,13 @@ PlyData readPlyForPreview(const std::string& path, std::size_t max_vertices,
                           std::size_t* total_vertices) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open PLY file");
-  const Header header = readHeader(in, path);
+  const PlyHeader header = readPlyHeader(in, path);
   VertexLayout layout;
   // Fast path: binary vertices first and no faces (elements after the vertices, such as PCL's
   // "camera", are ignored).
   bool has_faces = false;
-  for (const Elem& e : header.elements) has_faces |= e.name == "face" && e.count > 0;
-  const bool fast = header.binary_le && !has_faces && !header.elements.empty() &&
+  for (const PlyElement& e : header.elements) has_faces |= e.name == "face" && e.count > 0;
+  const bool fast = header.binary && !has_faces && !header.elements.empty() &&
                     header.elements[0].name == "vertex" &&
                     vertexLayout(header.elements[0], &layout);
   if (!fast) {  // meshes, ASCII, unusual layouts: the general reader
