@@ -13,22 +13,21 @@
 #include "dynamap/core/camera.hpp"
 #include "dynamap/mapping/flat_index.hpp"
 #include "dynamap/mapping/visibility.hpp"
+#include "dynamap/mapping/voxel_key.hpp"
 #include "plane_fit.hpp"
 #include "visibility_votes.hpp"
 
 namespace dynamap::vis {
 
-constexpr int kAxisBits = 21;
-constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
+constexpr int kAxisBits = kVoxelKeyAxisBits;
+constexpr std::uint64_t kAxisMask = kVoxelKeyAxisMask;
 
-/// 21 bits per axis (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
+/// packVoxelKey of p's cell (voxels of 2 cm: +-20 km); far points wrap, which only merges voxels.
 inline std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
-  const auto k = [inv_voxel](float v) {
-    const double cell = std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15);
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(cell) + (1 << (kAxisBits - 1))) &
-           kAxisMask;
+  const auto cell = [inv_voxel](float v) {
+    return static_cast<std::int64_t>(std::clamp(std::floor(double(v) * inv_voxel), -1e15, 1e15));
   };
-  return k(p.x()) | (k(p.y()) << kAxisBits) | (k(p.z()) << (2 * kAxisBits));
+  return packVoxelKey(cell(p.x()), cell(p.y()), cell(p.z()));
 }
 
 /// The key of the voxel (dx, dy, dz) cells away from `key`'s (wrapping as voxelKey() does).

@@ -5,16 +5,15 @@
 
 #include <Eigen/Core>
 
+#include "dynamap/mapping/voxel_key.hpp"
+
 namespace dynamap::plugin {
 
-/// Packs the integer voxel coordinates of p (21 bits per axis, +-10 km at 1 cm) into 64 bits.
+/// The key of the voxel holding p (dynamap::packVoxelKey of its integer cell).
 inline std::uint64_t voxelKey(const Eigen::Vector3f& p, float inv_voxel) {
-  constexpr std::int64_t kOffset = 1 << 20;
-  constexpr std::uint64_t kMask = (1u << 21) - 1;
-  const auto x = static_cast<std::uint64_t>(std::int64_t(std::floor(p.x() * inv_voxel)) + kOffset);
-  const auto y = static_cast<std::uint64_t>(std::int64_t(std::floor(p.y() * inv_voxel)) + kOffset);
-  const auto z = static_cast<std::uint64_t>(std::int64_t(std::floor(p.z() * inv_voxel)) + kOffset);
-  return (x & kMask) | ((y & kMask) << 21) | ((z & kMask) << 42);
+  return packVoxelKey(static_cast<std::int64_t>(std::floor(p.x() * inv_voxel)),
+                      static_cast<std::int64_t>(std::floor(p.y() * inv_voxel)),
+                      static_cast<std::int64_t>(std::floor(p.z() * inv_voxel)));
 }
 
 /// Running centroid and colour of the points in one voxel.

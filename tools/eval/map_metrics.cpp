@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "dynamap/mapping/ply_io.hpp"
+#include "dynamap/mapping/voxel_key.hpp"
 
 namespace dynamap {
 namespace {
@@ -15,12 +16,7 @@ namespace {
 constexpr std::uint32_t kLeafSize = 8;
 constexpr double kCoarseDiagonal = 1.7321 * ReferenceClouds::kCoarseVoxelM + 1e-4;
 
-std::uint64_t packCell(const Eigen::Vector3i& c) {
-  const auto k = [](int v) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(v) + (1 << 20)) & ((1u << 21) - 1);
-  };
-  return k(c.x()) | (k(c.y()) << 21) | (k(c.z()) << 42);
-}
+std::uint64_t packCell(const Eigen::Vector3i& c) { return packVoxelKey(c.x(), c.y(), c.z()); }
 
 // Runs fn(i) for i in [0, n) on two threads (the machines have 2 cores).
 template <typename Fn>
