@@ -7,7 +7,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "dynamap/core/dynamic/object_detector.hpp"
-#include "dynamap/core/dynamic/own_conv_layers.hpp"
+#ifdef DYNAMAP_HAVE_FAST_CONV
+#include "dynamap/fast_paths/own_conv_layers.hpp"
+#endif
 
 namespace dynamap {
 
@@ -82,11 +84,13 @@ class DarknetDetector : public NetDetector {
     requireFile(o.model_cfg, "Darknet cfg");
     requireFile(o.model_weights, "Darknet weights");
     // The size check comes before the probe: a net with uninitialised weights is never run.
-    // Its layers are made while the faster convolutions are registered
-    // (own_conv_layers.hpp: same outputs, bit for bit).
+    // With the fast paths, its layers are made while the faster convolutions are registered
+    // (core/fast_paths/own_conv_layers.hpp: the same outputs to float rounding).
     load(
         [&] {
+#ifdef DYNAMAP_HAVE_FAST_CONV
           ScopedOwnConvLayers own_convolutions;
+#endif
           cv::dnn::Net net = cv::dnn::readNetFromDarknet(o.model_cfg, o.model_weights);
           for (const auto& name : net.getLayerNames()) net.getLayer(net.getLayerId(name));
           return net;

@@ -5,21 +5,25 @@
 
 #include <opencv2/video/tracking.hpp>
 
-#include "dynamap/core/tracking/own_pyr_lk.hpp"
+#ifdef DYNAMAP_HAVE_FAST_PATHS
+#include "dynamap/fast_paths/own_pyr_lk.hpp"
+#endif
 
 namespace dynamap {
 namespace {
 
-/// OpenCV's pyramidal LK with initial flow, or its bit-for-bit twin where that runs here.
+/// OpenCV's pyramidal LK with initial flow, or the fast path's (core/fast_paths) where it runs.
 void pyramidalLk(const LkPyramid& from, const LkPyramid& to, const std::vector<cv::Point2f>& px,
                  std::vector<cv::Point2f>& tracked, std::vector<std::uint8_t>& status,
                  cv::Size window, int max_level, const cv::TermCriteria& criteria) {
+#ifdef DYNAMAP_HAVE_FAST_PATHS
   if (lk::ownPyrLkUsable(window)) {
     lk::ownPyrLk(from, to, px, tracked, status, window, max_level, criteria);
-  } else {
-    cv::calcOpticalFlowPyrLK(from, to, px, tracked, status, cv::noArray(), window, max_level,
-                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+    return;
   }
+#endif
+  cv::calcOpticalFlowPyrLK(from, to, px, tracked, status, cv::noArray(), window, max_level,
+                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
 }
 
 }  // namespace

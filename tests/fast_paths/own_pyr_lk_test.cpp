@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -9,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "dynamap/core/tracking/own_pyr_lk.hpp"
+#include "dynamap/fast_paths/own_pyr_lk.hpp"
 #include "test_paths.hpp"
 
 namespace dynamap {
@@ -24,23 +23,27 @@ struct Outcome {
   std::vector<std::uint8_t> status;
 };
 
-/// Both LKs from the same start; the number of points whose status or position bits differ.
-std::size_t differingPoints(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& next,
-                            const std::vector<cv::Point2f>& from,
-                            const std::vector<cv::Point2f>& guess, int max_level, int iterations) {
+/// Both LKs from the same start; the share of points on which they agree: the same status and,
+/// where both tracked the point, end positions within 0.01 px.
+double agreement(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& next,
+                 const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& guess,
+                 int max_level, int iterations) {
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, iterations,
                                   0.01);
   Outcome cv_out{guess, {}}, own{guess, {}};
   cv::calcOpticalFlowPyrLK(prev, next, from, cv_out.px, cv_out.status, cv::noArray(), kWindow,
                            max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
   lk::ownPyrLk(prev, next, from, own.px, own.status, kWindow, max_level, criteria);
-  std::size_t differ = 0;
+  std::size_t agree = 0;
   for (std::size_t i = 0; i < from.size(); ++i) {
-    differ += (cv_out.status[i] != 0) != (own.status[i] != 0) ||
-              std::memcmp(&cv_out.px[i], &own.px[i], sizeof(cv::Point2f)) != 0;
+    const bool cv_ok = cv_out.status[i] != 0, own_ok = own.status[i] != 0;
+    agree += cv_ok == own_ok && (!cv_ok || cv::norm(cv_out.px[i] - own.px[i]) <= 0.01);
   }
-  return differ;
+  return static_cast<double>(agree) / static_cast<double>(from.size());
 }
+
+/// The tolerance: 99.9 % of the points agree (float rounding may send an odd point elsewhere).
+constexpr double kMinAgreement = 0.999;
 
 std::vector<cv::Mat> pyramidOf(const cv::Mat& gray, int max_level) {
   std::vector<cv::Mat> pyramid;
@@ -70,8 +73,8 @@ std::vector<cv::Point2f> guesses(const std::vector<cv::Point2f>& from, cv::RNG& 
   return out;
 }
 
-TEST(OwnPyrLk, MatchesOpenCvBitForBitOnAShiftedTexture) {
-  if (!lk::ownPyrLkUsable(kWindow)) GTEST_SKIP() << "own LK not usable here (OpenCV/CPU)";
+TEST(OwnPyrLk, AgreesWithOpenCvOnAShiftedTexture) {
+  if (!lk::ownPyrLkUsable(kWindow)) GTEST_SKIP() << "own LK not usable here (CPU without AVX2)";
   cv::RNG rng(7);
   cv::Mat noise(480, 640, CV_8UC1);
   rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
@@ -85,16 +88,17 @@ TEST(OwnPyrLk, MatchesOpenCvBitForBitOnAShiftedTexture) {
   for (const int levels : {0, 2, 4}) {
     const auto prev = pyramidOf(gray, levels), next = pyramidOf(shifted, levels);
     for (const int iterations : {1, 5, 20}) {
-      EXPECT_EQ(differingPoints(prev, next, from, from, levels, iterations), 0u)
+      EXPECT_GE(agreement(prev, next, from, from, levels, iterations), kMinAgreement)
           << "levels " << levels << ", iterations " << iterations;
-      EXPECT_EQ(differingPoints(prev, next, from, guesses(from, rng, 12.f), levels, iterations), 0u)
+      EXPECT_GE(agreement(prev, next, from, guesses(from, rng, 12.f), levels, iterations),
+                kMinAgreement)
           << "levels " << levels << ", iterations " << iterations << ", noisy guesses";
     }
   }
 }
 
-TEST(OwnPyrLk, MatchesOpenCvBitForBitOnRealFrames) {
-  if (!lk::ownPyrLkUsable(kWindow)) GTEST_SKIP() << "own LK not usable here (OpenCV/CPU)";
+TEST(OwnPyrLk, AgreesWithOpenCvOnRealFrames) {
+  if (!lk::ownPyrLkUsable(kWindow)) GTEST_SKIP() << "own LK not usable here (CPU without AVX2)";
   DYNAMAP_REQUIRE_SHARED_DATA();
   for (const char* seq : {"dynamic/teddy_dyn_crowd_dev", "bonn/rgbd_bonn_crowd_400_499"}) {
     std::vector<fs::path> frames;
@@ -110,9 +114,9 @@ TEST(OwnPyrLk, MatchesOpenCvBitForBitOnRealFrames) {
       cv::cvtColor(cv::imread(frames[i + 3].string()), b, cv::COLOR_BGR2GRAY);
       const auto prev = pyramidOf(a, 5), next = pyramidOf(b, 5);
       const std::vector<cv::Point2f> from = testPoints(a, rng);
-      EXPECT_EQ(differingPoints(prev, next, from, guesses(from, rng, 4.f), 5, 20), 0u)
+      EXPECT_GE(agreement(prev, next, from, guesses(from, rng, 4.f), 5, 20), kMinAgreement)
           << frames[i] << " forward";
-      EXPECT_EQ(differingPoints(next, prev, from, from, 2, 20), 0u) << frames[i] << " backward";
+      EXPECT_GE(agreement(next, prev, from, from, 2, 20), kMinAgreement) << frames[i] << " backward";
     }
   }
 }

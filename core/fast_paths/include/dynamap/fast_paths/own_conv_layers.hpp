@@ -10,8 +10,8 @@ namespace dynamap {
 /// is slow for the shapes of a small detector: depthwise convolutions on planes under 18 pixels
 /// wide or with 5 x 5 kernels (about 1 GMAC/s; a 256 x 256 Yolo-Fastest's 16 x 16 and 8 x 8
 /// stages) and the 1 x 1 convolutions. This layer runs those cases with its own kernels
-/// (conv_kernels.hpp): OpenCV's arithmetic in OpenCV's order, so its outputs are bit for bit
-/// those of OpenCV's layer and the detector's boxes, masks and poses do not change. Every other
+/// (conv_kernels.hpp), whose outputs agree with OpenCV's layer's to float rounding
+/// (tests/fast_paths, with a tolerance). Every other
 /// case (another path, activation, CPU or layout) runs OpenCV's layer, which it wraps and keeps
 /// fused alike. Depthwise and 1 x 1 layers get this layer; the others are OpenCV's own.
 cv::Ptr<cv::dnn::Layer> createConvolutionLayer(cv::dnn::LayerParams& params);

@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <string>
 
 #include <opencv2/core/utility.hpp>
 
@@ -134,32 +133,16 @@ __attribute__((target("avx512f,avx2,fma"))) void pointwiseAvx512(const Pointwise
   }
 }
 
-/// True if this OpenCV build has code for `feature` (baseline or dispatched): only then does it
-/// sum in that variant's order on a CPU that has it.
-bool openCvBuiltFor(const std::string& feature) {
-  const std::string info = cv::getBuildInformation();
-  for (const char* key : {"Baseline:", "Dispatched code generation:"}) {
-    const std::size_t at = info.find(key);
-    if (at == std::string::npos) continue;
-    const std::string line = info.substr(at, info.find('\n', at) - at);
-    if ((" " + line + " ").find(" " + feature + " ") != std::string::npos) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 bool cpuHasAvx2Fma() {
-  // The kernels follow OpenCV 4.6's generic convolution path (4.7 replaced it).
-  static const bool has = cv::getVersionMajor() == 4 && cv::getVersionMinor() == 6 &&
-                          cv::checkHardwareSupport(CV_CPU_AVX2) &&
-                          cv::checkHardwareSupport(CV_CPU_FMA3) && openCvBuiltFor("AVX2");
+  static const bool has =
+      cv::checkHardwareSupport(CV_CPU_AVX2) && cv::checkHardwareSupport(CV_CPU_FMA3);
   return has;
 }
 
 bool cpuHasAvx512() {
-  static const bool has = cpuHasAvx2Fma() && cv::checkHardwareSupport(CV_CPU_AVX512_SKX) &&
-                          openCvBuiltFor("AVX512_SKX");
+  static const bool has = cpuHasAvx2Fma() && cv::checkHardwareSupport(CV_CPU_AVX512_SKX);
   return has;
 }
 

@@ -1,4 +1,4 @@
-#include "dynamap/core/dynamic/own_conv_layers.hpp"
+#include "dynamap/fast_paths/own_conv_layers.hpp"
 
 #include <algorithm>
 #include <vector>

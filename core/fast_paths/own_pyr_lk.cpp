@@ -1,4 +1,4 @@
-#include "dynamap/core/tracking/own_pyr_lk.hpp"
+#include "dynamap/fast_paths/own_pyr_lk.hpp"
 
 #include <immintrin.h>
 
@@ -9,9 +9,6 @@
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
-
-// This file is compiled with -ffp-contract=off (core/CMakeLists.txt): OpenCV's LK multiplies
-// and adds in separate roundings (its SSE2 build has no FMA), and so must every line here.
 
 namespace dynamap::lk {
 namespace {
@@ -266,8 +263,7 @@ int derivLevels(const std::vector<cv::Mat>& pyramid) {
 
 bool ownPyrLkUsable(cv::Size window) {
 #if defined(__x86_64__)
-  static const bool cpu = cv::getVersionMajor() == 4 && cv::getVersionMinor() == 6 &&
-                          cv::checkHardwareSupport(CV_CPU_AVX2);
+  static const bool cpu = cv::checkHardwareSupport(CV_CPU_AVX2);
   return cpu && window.width == kWidth && window.height >= 3;
 #else
   (void)window;

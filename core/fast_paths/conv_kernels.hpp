@@ -4,12 +4,10 @@
 
 namespace dynamap::conv {
 
-/// Kernels that compute what OpenCV 4.6's generic convolution path computes (im2row, then its
-/// fastConv dot products), bit for bit, faster: each output is summed in OpenCV's order (its
-/// lanes of fused multiply-adds, its pairwise sum of the lanes, bias + sum, leaky ReLU) while the
-/// vector lanes here hold neighbouring output pixels. Callers check first that OpenCV is 4.6,
-/// that the CPU has the instructions and that OpenCV was built for them (its variant of that
-/// name then runs).
+/// Kernels for the convolutions that OpenCV 4.6's generic path (im2row, then dot products)
+/// runs slowly: the vector lanes hold neighbouring output pixels. They follow OpenCV's summation
+/// order, so results agree with OpenCV's to float rounding (tests/fast_paths, with a tolerance).
+/// x86-64 only; callers check the CPU first.
 bool cpuHasAvx2Fma();
 bool cpuHasAvx512();
 

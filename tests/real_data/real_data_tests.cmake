@@ -1,0 +1,17 @@
+# ctest -L real_data: tests/real_data/bands.py check CASE for every case it lists.
+set(bands_py ${CMAKE_CURRENT_LIST_DIR}/bands.py)
+execute_process(COMMAND /usr/bin/python3 ${bands_py} list OUTPUT_VARIABLE cases
+                RESULT_VARIABLE listed OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT listed EQUAL 0)
+  message(FATAL_ERROR "tests/real_data/bands.py list failed (needs /usr/bin/python3)")
+endif()
+string(REPLACE "\n" ";" cases "${cases}")
+foreach(case IN LISTS cases)
+  add_test(NAME real_data.${case}
+           COMMAND /usr/bin/python3 ${bands_py} check ${case} --dynamap $<TARGET_FILE:dynamap>
+                   --work ${PROJECT_BINARY_DIR}/real_data)
+  set_tests_properties(real_data.${case} PROPERTIES LABELS real_data TIMEOUT 900)
+endforeach()
+add_test(NAME real_data.band_logic COMMAND /usr/bin/python3 -m pytest -q
+         ${CMAKE_CURRENT_LIST_DIR}/test_bands.py)
+set_tests_properties(real_data.band_logic PROPERTIES LABELS unit)
