@@ -7,6 +7,7 @@
                                                       run every case's variants, write bands.json
   bands.py limits                                     recompute every limit from the samples
                                                       in bands.json (after a change of the rule)
+  bands.py table                                      bands.json as a Markdown table
   bands.py list                                       the cases, one a line
 
 A case is a sequence from ../shared/data (as it is, or a variant generated from it: played
@@ -240,6 +241,28 @@ def recompute_limits():
     return 0
 
 
+def print_table():
+    """One row a case, one column a metric: the samples' mean and the band's limit."""
+    result = load_bands()
+    how = result["how_measured"]
+    print("Measured %s at %s on %s: `%s`. A cell: the mean of the samples, then the limit "
+          "(≤ at most, ≥ at least).\n" % (how["date"], how["commit"], how["machine"], how["command"]))
+    print("| case | " + " | ".join(METRICS) + " |")
+    print("|---" * (len(METRICS) + 1) + "|")
+    for case, metrics in sorted(result["cases"].items()):
+        cells = []
+        for metric in METRICS:
+            entry = metrics.get(metric)
+            if entry is None:
+                cells.append("")
+                continue
+            band = entry["band"]
+            limit = "≤ %.3g" % band["max"] if "max" in band else "≥ %.3g" % band["min"]
+            cells.append("%.3g %s" % (entry["mean"], limit))
+        print("| %s | %s |" % (case, " | ".join(cells)))
+    return 0
+
+
 def write_bands(result):
     with open(BANDS_FILE, "w") as f:
         json.dump(result, f, indent=1, sort_keys=True)
@@ -259,7 +282,7 @@ def cpu_model():
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("command", choices=["check", "measure", "limits", "list"])
+    parser.add_argument("command", choices=["check", "measure", "limits", "table", "list"])
     parser.add_argument("case", nargs="?")
     parser.add_argument("--dynamap", nargs="+", default=[os.path.join(SOURCE, "build/bin/dynamap")])
     parser.add_argument("--builds", nargs="*", help="names of the --dynamap builds (measure)")
@@ -274,6 +297,8 @@ def main():
             return 0
         if args.command == "limits":
             return recompute_limits()
+        if args.command == "table":
+            return print_table()
         if args.command == "check":
             if args.case not in CASES:
                 raise SystemExit("real_data: unknown case '%s' (known: %s)" % (args.case,
