@@ -8,6 +8,7 @@
 #include "dynamap/core/dynamic/class_table.hpp"
 #include "dynamap/core/dynamic/depth_check.hpp"
 #include "dynamap/core/dynamic/nms.hpp"
+#include "dynamap/core/dynamic/object_pixels.hpp"
 #include "dynamap/core/dynamic/object_tracks.hpp"
 #include "dynamap/core/dynamic_config.hpp"
 
@@ -87,20 +88,6 @@ struct FusionResult {
   int seen_through = 0;  ///< regions the dense check added (DynamicMotionFilter)
 };
 
-/// The object's own pixels inside `box`: pixels within `band_m` of the dominant depth mode of
-/// the box centre, largest connected component, holes closed. Empty Mat if no depth.
-/// Returns a full-image CV_8UC1 mask (255 = object) and the mode in *depth_mode_m. Pixels of
-/// `not_object` (CV_8UC1, may be empty) are never the object's; if the box holds depth but only
-/// there, the mask is all zero (an empty Mat still means: no depth). With `prior_only` (and a
-/// prior) the mask is all zero too when the centre holds depth but none within 0.5 m of the prior:
-/// the object is no longer in the box (a carried box at the image border it walked out through).
-/// Depth beyond `max_depth_m` (> 0) is never the object's: where the box holds only such depth,
-/// the mask is all zero.
-cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box, double band_m,
-                     double* depth_mode_m, double prior_depth_m = 0.0,
-                     const cv::Mat& not_object = cv::Mat(), bool prior_only = false,
-                     double max_depth_m = 0.0);
-
 /// Fuses dynamic points and detections into a motion mask, with per-object temporal state
 /// (objects are associated frame to frame by box IoU, boxes moved with the flow).
 /// Keeping an object of a high-dynamic class (a person) takes evidence gathered over time: it
@@ -120,6 +107,8 @@ class RegionFusion {
                     const FusionEvidence& evidence = FusionEvidence());
 
  private:
+  struct Frame;  ///< one fuse() call's inputs and masks (region_fusion.cpp)
+
   /// Drops a high-dynamic detection that overlaps (IoU >= 0.6) a better-scored detection of a
   /// class that does not move by itself: the detector's two labels of one object.
   std::vector<Detection> oneLabelPerObject(const std::vector<Detection>& in) const;
@@ -127,36 +116,32 @@ class RegionFusion {
   ObjectDecision newDecision(const Detection& detection) const;
   /// Moves every track's box by the median flow of the points inside it.
   void propagateTracks(const std::vector<cv::Point2f>& points, const FusionEvidence& evidence);
-  /// Decides `d` given its track in the last frame (null: new object); returns its new track.
-  ObjectTrack decideObject(ObjectDecision& d, const ObjectTrack* prev,
-                           const FusionEvidence& evidence) const;
-  /// The object's own pixels in `box` (depth cut, or the box without depth); counts the
-  /// points on them into d.
-  cv::Mat objectRegion(const cv::Mat& depth_m, const cv::Rect& box, ObjectDecision& d,
-                       const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
+  /// Decides and masks each detection, its next track into `next`; returns, per track of the
+  /// last frame, whether a detection continued it.
+  std::vector<bool> fuseDetections(Frame& f, const std::vector<Detection>& detections,
+                                   std::vector<ObjectTrack>& next, FusionResult& result) const;
+  /// Decides and masks the tracks no detection continued (for track_max_missed_frames).
+  void carryUndetected(Frame& f, const std::vector<bool>& matched, std::vector<ObjectTrack>& next,
+                       FusionResult& result) const;
+  /// Confirmed objects out of the mask, clusters grown, the masks' margins.
+  void finishMasks(Frame& f, FusionResult& result) const;
+  /// The object's depth cut in `box` (objectPixels(); the box without depth).
+  cv::Mat depthCut(const Frame& f, const cv::Rect& box, ObjectDecision& d,
+                   const ObjectTrack* prev) const;
+  /// The object's own pixels in `box` (depthCut()); counts the points on them into d, its world
+  /// position and its anchors against `prev` (its track in the last frame, may be null).
+  cv::Mat objectRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d,
                        const ObjectTrack* prev) const;
-  /// FusionEvidence::point_ids of the points inside `region` (empty without ids).
-  std::vector<std::uint64_t> idsIn(const cv::Mat& region,
-                                   const std::vector<cv::Point2f>& points) const;
-  /// Masks (moving, static points carved out) or keeps the decided object.
-  void applyObject(FusionMode mode, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
-                   const std::vector<cv::Point2f>& points, const std::vector<std::uint8_t>& dyn,
+  /// objectRegion() of a detection whose track is tracks_[track] (-1: none); without one, in
+  /// kBoth, the track whose anchors hold its points (then `track` and d are set anew).
+  cv::Mat detectedRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d, int& track) const;
+  /// Marks the object's pixels claimed and masks (moving, static points carved out) or keeps it.
+  void applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                    FusionResult& result) const;
-  /// True if the earlier view (FusionEvidence::view) saw `region` (inside `roi`) in place: at
-  /// least cluster_max_consistent of its depth samples agree with that view.
-  bool inPlaceEarlier(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rect& roi) const;
-  int growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
-                   const std::vector<std::uint8_t>& dyn, const cv::Mat& claimed,
-                   cv::Mat& mask) const;
 
   DynamicConfig config_;
   ClassTable classes_;
   std::vector<ObjectTrack> tracks_;
-  std::vector<std::uint8_t> proven_;  ///< this frame's FusionEvidence::proven_static
-  cv::Mat confirmed_;                 ///< this frame's pixels of objects confirmed static over time
-  cv::Mat evidenced_;                 ///< this frame's pixels of objects masked for motion
-  cv::Mat certain_;                   ///< this frame's moving pixels with evidence of their own
-  const FusionEvidence* evidence_ = nullptr;  ///< during fuse()
 };
 
 }  // namespace dynamap

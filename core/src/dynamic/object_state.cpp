@@ -1,0 +1,176 @@
+#include "object_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dynamap {
+
+namespace {
+
+constexpr int kStaticMinPoints = 5;   ///< points needed on an object to call it static now
+constexpr int kMaxSlowDoublings = 4;  ///< ObjectTrack::slow_moves: at most 16 x the frames
+
+/// What an object's own points, followed over time, say in this frame: against the pose from
+/// landmarks proven static they are within the pose noise (still), clearly off (twice that) or
+/// in between (no verdict).
+enum class AnchorVerdict {
+  kNone,       ///< too few anchored points, or no still limit: the anchors say nothing
+  kStill,      ///< within the still limit
+  kUndecided,  ///< beyond the still limit, within twice it
+  /// Beyond twice it, but the person was confirmed still with still anchors: a jump from within
+  /// the still limit in one frame (a pose error, or the semi-synthetic sequences' ground-truth
+  /// jitter) is masked in this frame only; the count and the anchors restart only when the next
+  /// frame sees them off again (static_anchor_move_frames).
+  kJumpHeld,
+  kMoved,  ///< beyond twice it: the object moved
+};
+
+/// This frame's evidence on one object.
+struct Observation {
+  bool observed = false;  ///< flags valid and enough points on the object
+  double evidence = 0.0;  ///< class prior x share of dynamic points on its own pixels
+  bool flagged = false;   ///< its flags say it moves (whatever its anchors say)
+  bool quiet = false;     ///< enough points on it, few of them dynamic
+  AnchorVerdict anchors = AnchorVerdict::kNone;
+  bool confirmed_before = false;  ///< counted still, and not moving, in the last frame
+
+  bool anchored() const { return anchors != AnchorVerdict::kNone; }
+  /// Flags the anchors do not confirm were measured against a wrong camera motion: they mask
+  /// the object in this frame but restart neither its quiet count nor its anchors.
+  bool movingNow() const { return flagged && !(anchored() && anchors != AnchorVerdict::kMoved); }
+};
+
+bool countedStill(const ObjectTrack* prev, const DynamicConfig& c) {
+  return prev != nullptr && prev->quiet_frames >= c.static_confirm_frames;
+}
+
+AnchorVerdict judgeAnchors(const ObjectDecision& d, const ObjectTrack* prev, const cv::Vec4d& K,
+                           const DynamicConfig& c) {
+  // The pose noise in pixels, or a still person's postural sway (static_anchor_m) seen at its
+  // depth, whichever is larger.
+  const double sway_px = d.depth_m > 0.0 && K[0] > 0.0 ? c.static_anchor_m * K[0] / d.depth_m : 0.0;
+  const double tau = c.static_anchor_px > 0.0 ? std::max(c.static_anchor_px, sway_px) : 0.0;
+  if (!(tau > 0.0 && d.anchor.points >= kAnchorMinPoints)) return AnchorVerdict::kNone;
+  const double tau_z = c.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
+  if (d.anchor.median_px <= tau && dz <= tau_z) return AnchorVerdict::kStill;
+  if (!(d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z)) return AnchorVerdict::kUndecided;
+  const bool held = c.static_anchor_move_frames > 1 && countedStill(prev, c) && prev->anchors_still;
+  return held ? AnchorVerdict::kJumpHeld : AnchorVerdict::kMoved;
+}
+
+Observation observe(const ObjectDecision& d, const ObjectTrack* prev, const FusionEvidence& ev,
+                    const DynamicConfig& c) {
+  Observation obs;
+  obs.observed = ev.flags_valid && d.points >= c.min_object_points;
+  obs.evidence = obs.observed ? d.weight * d.dynamic_points / d.points : 0.0;
+  obs.flagged =
+      obs.observed && d.dynamic_points >= c.min_dynamic_points && obs.evidence >= c.moving_ratio;
+  obs.quiet = obs.observed && d.points >= kStaticMinPoints &&
+              d.dynamic_points <= c.static_max_dynamic_share * d.points;
+  obs.anchors = judgeAnchors(d, prev, ev.K, c);
+  obs.confirmed_before = countedStill(prev, c) && !prev->moving;
+  return obs;
+}
+
+/// The new track: where the object is, and its slow moves (anchors off without flags).
+ObjectTrack startTrack(const ObjectDecision& d, const ObjectTrack* prev, const Observation& obs,
+                       const DynamicConfig& c) {
+  ObjectTrack t;
+  t.box = d.detection.box;
+  t.depth_m = d.depth_m > 0.0 || prev == nullptr ? d.depth_m : prev->depth_m;
+  t.anchors_still = obs.anchors == AnchorVerdict::kStill;
+  t.class_id = d.detection.class_id;
+  // A depth cut that jumped is another surface (the track went to another object): it starts
+  // with no slow moves.
+  const bool jumped = prev != nullptr && d.depth_m > 0.0 && prev->depth_m > 0.0 &&
+                      std::abs(d.depth_m - prev->depth_m) >= c.depth_band_m;
+  const bool slow_move = obs.anchors == AnchorVerdict::kMoved && !obs.flagged && !jumped;
+  t.slow_moves = (prev != nullptr && !jumped ? prev->slow_moves : 0) + (slow_move ? 1 : 0);
+  return t;
+}
+
+/// Temporal hysteresis: the smoothed evidence must reach moving_ratio (with enough dynamic
+/// points now) to turn the object moving; it stays moving until it falls below half of it.
+/// Clear static evidence counts twice (a faster release). Unobserved frames keep the state.
+void smoothEvidence(ObjectTrack& t, const ObjectTrack* prev, const Observation& obs,
+                    const DynamicConfig& c) {
+  const double a = c.evidence_smoothing;
+  t.score = obs.evidence;
+  if (prev != nullptr) {
+    t.score = obs.observed ? a * prev->score + (1.0 - a) * obs.evidence : prev->score;
+  }
+  const bool was_moving = prev != nullptr && prev->moving;
+  t.moving =
+      was_moving ? t.score >= 0.5 * c.moving_ratio : (obs.movingNow() && t.score >= c.moving_ratio);
+  if (prev != nullptr && obs.quiet) {
+    t.score = a * t.score + (1.0 - a) * obs.evidence;
+    t.moving = was_moving && t.score >= 0.5 * c.moving_ratio;
+  }
+}
+
+/// Keeping a person takes evidence gathered over time, measured against a camera motion fitted
+/// without it; one frame of clear motion removes it again. Counts the quiet frames and keeps
+/// (or restarts) the anchors and the world position they are counted from.
+void countQuietFrames(ObjectTrack& t, const ObjectDecision& d, const ObjectTrack* prev,
+                      const Observation& obs, bool background_fit, const DynamicConfig& c) {
+  int before = prev != nullptr ? prev->quiet_frames : 0;
+  if (prev != nullptr && prev->has_anchor) t.has_anchor = true, t.anchor_W = prev->anchor_W;
+  bool still = false;  // its world position stayed put (camera pose from proven landmarks)
+  t.anchors = d.anchor.kept;
+  if (obs.anchored()) {
+    // Its own points, followed over time, tell better than its centroid.
+    still = obs.anchors == AnchorVerdict::kStill;
+    if (obs.anchors == AnchorVerdict::kMoved) {
+      t.anchors = d.anchor.fresh, before = 0;
+      t.has_anchor = d.has_position, t.anchor_W = d.p_W;
+    }
+  } else if (d.has_position && c.static_max_drift_m > 0.0) {
+    // Frame-to-frame checks cannot see a slow walker (a pixel a frame): its world position can.
+    if (!t.has_anchor || cv::norm(d.p_W - t.anchor_W) > c.static_max_drift_m) {
+      t.has_anchor = true, t.anchor_W = d.p_W, before = 0;
+    } else {
+      still = true;
+    }
+  }
+  // Static evidence of this frame: its points agree with the background's motion, or, when it
+  // has too few points to tell (a plain jacket, the depth-less border), its world position.
+  const bool few_points = d.points < kStaticMinPoints;
+  const bool evidence_now = obs.anchored() ? obs.anchors == AnchorVerdict::kStill
+                                           : (obs.quiet && background_fit) || (few_points && still);
+  t.quiet_frames = obs.movingNow() ? 0 : before + (evidence_now ? 1 : 0);
+  if (obs.movingNow()) t.has_anchor = false, t.anchors = d.anchor.fresh;
+}
+
+/// A person is masked until he has shown, for long enough, that he stands still; anchors off by
+/// more than the pose noise mask him in this frame (his count is kept).
+void holdUntilConfirmed(ObjectTrack& t, ObjectDecision& d, const Observation& obs,
+                        const DynamicConfig& c) {
+  const int needed = c.static_confirm_frames << std::min(t.slow_moves, kMaxSlowDoublings);
+  const bool evidenced = t.moving || (obs.anchored() && obs.anchors != AnchorVerdict::kStill);
+  t.moving = evidenced || t.quiet_frames < needed;
+  d.unconfirmed =
+      t.moving && !evidenced && !obs.flagged && t.slow_moves == 0 && t.score < c.moving_ratio;
+}
+
+}  // namespace
+
+ObjectTrack nextObjectState(ObjectDecision& d, const ObjectTrack* prev,
+                            const FusionEvidence& evidence, const DynamicConfig& config,
+                            bool high_dynamic) {
+  const Observation obs = observe(d, prev, evidence, config);
+  d.moving_now = obs.movingNow();
+  ObjectTrack t = startTrack(d, prev, obs, config);
+  smoothEvidence(t, prev, obs, config);
+  countQuietFrames(t, d, prev, obs, evidence.background_fit, config);
+  // A person confirmed still whose flags his anchors do not confirm (they drifted, but less than
+  // twice the pose noise) is masked now but held: hindsight may keep him in the map.
+  const bool moved = obs.anchors == AnchorVerdict::kMoved;
+  const bool unconfirmed_flags = obs.confirmed_before && obs.anchored() && !moved;
+  d.motion_now = (obs.flagged && !unconfirmed_flags) || moved || t.moving;
+  if (high_dynamic) holdUntilConfirmed(t, d, obs, config);
+  d.moving = t.moving;
+  d.quiet_frames = t.quiet_frames;
+  return t;
+}
+
+}  // namespace dynamap
