@@ -39,6 +39,45 @@ bool inMask(const cv::Mat& mask, const cv::Point2f& p) {
          mask.at<uchar>(y, x) != 0;
 }
 
+/// The tracker's camera motion as checkRigidMotion() writes motions: X_prev = R X_cur + t
+/// (valid false without a prior).
+RigidMotion priorMotion(const MotionFilterInput& input) {
+  RigidMotion prior;
+  if (!input.has_prior) return prior;
+  const Eigen::Matrix3d R = input.T_prev_cur.rotation();
+  const cv::Matx33d Rm(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1),
+                       R(2, 2));
+  cv::Rodrigues(Rm, prior.rvec);
+  const Eigen::Vector3d t = input.T_prev_cur.translation();
+  prior.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+  prior.valid = true;
+  return prior;
+}
+
+/// Per match: dynamic (flagged, or on the mask) and held back; the masks of `fused`.
+MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
+                                const std::vector<std::uint8_t>& flagged,
+                                const FusionResult& fused) {
+  MotionFilterOutput out;
+  out.match_is_dynamic.resize(cur_px.size(), 0);
+  for (std::size_t i = 0; i < cur_px.size(); ++i) {
+    // A lone flag on an object decided static (e.g. the teddy taken for a person, whose near
+    // points have larger residuals) is noise: the object-level decision wins.
+    const bool lone_flag = flagged[i] && !inMask(fused.static_objects, cur_px[i]);
+    out.match_is_dynamic[i] = (lone_flag || inMask(fused.mask, cur_px[i])) ? 1 : 0;
+  }
+  out.match_held.assign(cur_px.size(), 0);
+  for (std::size_t i = 0; i < cur_px.size() && !fused.unconfirmed.empty(); ++i) {
+    out.match_held[i] = !flagged[i] && inMask(fused.unconfirmed, cur_px[i]) ? 1 : 0;
+  }
+  out.unconfirmed_mask = fused.unconfirmed;
+  if (!fused.held.empty() && cv::countNonZero(fused.held) > 0) out.held_mask = fused.held;
+  if (!fused.confirmed.empty() && cv::countNonZero(fused.confirmed) > 0)
+    out.confirmed_mask = fused.confirmed;
+  if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
+  return out;
+}
+
 }  // namespace
 
 DetectorOptions detectorOptions(const DynamicConfig& c) {
@@ -242,40 +281,24 @@ cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
   return on_plane;
 }
 
-MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
-  static const FeatureMatches kNoMatches;
-  const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
-  auto dets = currentDetections(input.frame, m);
-  const cv::Mat frame_depth = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
-
-  auto start = Clock::now();
+EpipolarResult DynamicMotionFilter::flagMovingPoints(const MotionFilterInput& input,
+                                                     const FeatureMatches& m,
+                                                     const cv::Mat& depth_m,
+                                                     const std::vector<Detection>& dets,
+                                                     bool* background_fit) {
+  const auto start = Clock::now();
   EpipolarResult epi;
-  FusionEvidence evidence;
   if (mode_ != FusionMode::kDetector) {
-    RigidMotion prior;
-    if (input.has_prior) {
-      // X_prev = R X_cur + t, as checkRigidMotion() writes motions.
-      const Eigen::Matrix3d R = input.T_prev_cur.rotation();
-      const cv::Matx33d Rm(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1),
-                           R(2, 2));
-      cv::Rodrigues(Rm, prior.rvec);
-      const Eigen::Vector3d t = input.T_prev_cur.translation();
-      prior.tvec = cv::Vec3d(t.x(), t.y(), t.z());
-      prior.valid = true;
-    }
-    epi = checkGeometry(m, frame_depth, dets, prior.valid ? &prior : nullptr,
-                        &evidence.background_fit);
+    const RigidMotion prior = priorMotion(input);
+    epi = checkGeometry(m, depth_m, dets, prior.valid ? &prior : nullptr, background_fit);
   }
   epi.is_dynamic.resize(m.cur_px.size(), 0);
   record("epipolar", msSince(start));
-  evidence.planes = supportPlanePixels(frame_depth, dets);  // records its own time
+  return epi;
+}
 
-  start = Clock::now();
-  cv::Mat depth = frame_depth;
-  if (depth.empty()) {
-    const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
-    depth = cv::Mat::zeros(size, CV_32FC1);
-  }
+void DynamicMotionFilter::gatherEvidence(const MotionFilterInput& input, const FeatureMatches& m,
+                                         const EpipolarResult& epi, FusionEvidence& evidence) {
   evidence.flags_valid = mode_ == FusionMode::kDetector || epi.model != EpipolarModel::kNone;
   evidence.prev_points = m.prev_px;
   if (input.proven_static != nullptr) evidence.proven_static = *input.proven_static;
@@ -288,34 +311,37 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   }
   if (evidence.has_pose && config_.dense_check_frames > 0)
     evidence.view = depth_history_.newestUpTo(filtered_ - config_.dense_check_frames);
+}
+
+FusionResult DynamicMotionFilter::fuseRegions(const MotionFilterInput& input,
+                                              const FeatureMatches& m, const cv::Mat& depth_m,
+                                              const std::vector<Detection>& dets,
+                                              const EpipolarResult& epi, FusionEvidence& evidence) {
+  auto start = Clock::now();
+  cv::Mat depth = depth_m;
+  if (depth.empty()) {
+    const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
+    depth = cv::Mat::zeros(size, CV_32FC1);
+  }
+  gatherEvidence(input, m, epi, evidence);
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
   record("fusion", msSince(start));
   start = Clock::now();
-  if (evidence.has_pose && mode_ != FusionMode::kDetector)
-    addSeenThrough(frame_depth, evidence, fused);
+  if (evidence.has_pose && mode_ != FusionMode::kDetector) addSeenThrough(depth_m, evidence, fused);
   record("dense_check", msSince(start));
-  MotionFilterOutput out;
-  out.match_is_dynamic.resize(m.cur_px.size(), 0);
-  for (std::size_t i = 0; i < m.cur_px.size(); ++i) {
-    // A lone flag on an object decided static (e.g. the teddy taken for a person, whose near
-    // points have larger residuals) is noise: the object-level decision wins.
-    const bool lone_flag = epi.is_dynamic[i] && !inMask(fused.static_objects, m.cur_px[i]);
-    out.match_is_dynamic[i] = (lone_flag || inMask(fused.mask, m.cur_px[i])) ? 1 : 0;
-  }
-  out.match_held.assign(m.cur_px.size(), 0);
-  for (std::size_t i = 0; i < m.cur_px.size() && !fused.unconfirmed.empty(); ++i) {
-    out.match_held[i] = !epi.is_dynamic[i] && inMask(fused.unconfirmed, m.cur_px[i]) ? 1 : 0;
-  }
-  out.unconfirmed_mask = fused.unconfirmed;
-  if (!fused.held.empty() && cv::countNonZero(fused.held) > 0) out.held_mask = fused.held;
-  if (!fused.confirmed.empty() && cv::countNonZero(fused.confirmed) > 0)
-    out.confirmed_mask = fused.confirmed;
-  if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
-  prev_mask_ = fused.mask;
-  pending_ = DepthView();
-  if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(frame_depth, filtered_);
-  ++filtered_;
+  return fused;
+}
 
+void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const cv::Mat& mask) {
+  prev_mask_ = mask;
+  pending_ = DepthView();
+  if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);
+  ++filtered_;
+}
+
+void DynamicMotionFilter::keepDiagnostics(const FeatureMatches& m, const EpipolarResult& epi,
+                                          const MotionFilterOutput& out,
+                                          std::vector<Detection> dets, FusionResult fused) {
   diagnostics_.matches = m;
   diagnostics_.epipolar_dynamic = epi.is_dynamic;
   diagnostics_.residual_px = epi.residual_px;
@@ -326,6 +352,21 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   diagnostics_.clusters = fused.clusters;
   diagnostics_.seen_through = fused.seen_through;
   diagnostics_.mask = fused.mask;
+}
+
+// The per-frame step: detections -> geometric check of the matches -> fusion of the two.
+MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
+  static const FeatureMatches kNoMatches;
+  const FeatureMatches& m = input.matches != nullptr ? *input.matches : kNoMatches;
+  std::vector<Detection> dets = currentDetections(input.frame, m);
+  const cv::Mat depth_m = input.frame != nullptr ? input.frame->depth_m : cv::Mat();
+  FusionEvidence evidence;
+  const EpipolarResult epi = flagMovingPoints(input, m, depth_m, dets, &evidence.background_fit);
+  evidence.planes = supportPlanePixels(depth_m, dets);  // records its own time
+  FusionResult fused = fuseRegions(input, m, depth_m, dets, epi, evidence);
+  MotionFilterOutput out = filterOutput(m.cur_px, epi.is_dynamic, fused);
+  endFrame(depth_m, fused.mask);
+  keepDiagnostics(m, epi, out, std::move(dets), std::move(fused));
   return out;
 }
 

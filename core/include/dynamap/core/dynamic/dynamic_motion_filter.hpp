@@ -82,6 +82,24 @@ class DynamicMotionFilter : public MotionFilter {
   EpipolarResult checkGeometry(const FeatureMatches& m, const cv::Mat& depth,
                                const std::vector<Detection>& dets, const RigidMotion* prior,
                                bool* background_fit);
+  /// The geometric check of the matches against the camera motion (none in kDetector mode):
+  /// is_dynamic has one flag per match. Records "epipolar".
+  EpipolarResult flagMovingPoints(const MotionFilterInput& input, const FeatureMatches& m,
+                                  const cv::Mat& depth_m, const std::vector<Detection>& dets,
+                                  bool* background_fit);
+  /// Fills what fusion may rely on in this frame besides the flags (and keeps the last depth).
+  void gatherEvidence(const MotionFilterInput& input, const FeatureMatches& m,
+                      const EpipolarResult& epi, FusionEvidence& evidence);
+  /// Fusion of the flags and the detections, then the dense check. Records "fusion" and
+  /// "dense_check".
+  FusionResult fuseRegions(const MotionFilterInput& input, const FeatureMatches& m,
+                           const cv::Mat& depth_m, const std::vector<Detection>& dets,
+                           const EpipolarResult& epi, FusionEvidence& evidence);
+  /// What the next frame needs of this one: its mask and (dense check) its depth.
+  void endFrame(const cv::Mat& depth_m, const cv::Mat& mask);
+  void keepDiagnostics(const FeatureMatches& m, const EpipolarResult& epi,
+                       const MotionFilterOutput& out, std::vector<Detection> dets,
+                       FusionResult fused);
 
   DynamicConfig config_;
   cv::Vec4d K_;  ///< fx, fy, cx, cy
