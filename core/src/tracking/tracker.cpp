@@ -35,7 +35,7 @@ Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
   if (config_.bundle_adjustment) ba_.start();
 }
 
-// The per-frame step: match -> dynamic filter -> pose -> (relocalize) -> keyframe.
+// The per-frame step: match -> dynamic filter -> pose (with its fallbacks) -> keyframe -> commit.
 TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   ScopedStageTimer total(timings_, "tracking");
   if (frame.depth_m.empty() || cv::countNonZero(frame.depth_m) == 0) return poseWithoutDepth(frame);
@@ -51,6 +51,31 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     trackProbes(pyramid, matches);
   }
   TrackingResult result;
+  MotionFilterOutput widened;
+  const MotionFilterOutput filtered =
+      removeMovers(frame, gray, matches, T_W_C_pred, widened, result);
+  if (!initialized_) {
+    startMap(frame, gray, filtered, widened, result);
+  } else {
+    Eigen::Isometry3d T_W_C = T_W_C_pred;
+    result.status = solvePose(frame, gray, widened, T_W_C, result.inliers);
+    if (result.status != FrameStatus::kLost) {
+      result.T_W_C = T_W_C;
+      // Held-back objects (a teddy taken for a person) are no movers: they do not count.
+      if (needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
+        result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
+      }
+    }
+  }
+  commitFrame(frame, gray, std::move(pyramid), result);
+  return result;
+}
+
+MotionFilterOutput Tracker::Impl::removeMovers(const RgbdFrame& frame, const cv::Mat& gray,
+                                               const FeatureMatches& matches,
+                                               const Eigen::Isometry3d& T_W_C_pred,
+                                               MotionFilterOutput& widened,
+                                               TrackingResult& result) {
   Eigen::Isometry3d T_W_C_prior = T_W_C_pred;
   const bool has_prior = filter_ && priorPose(frame, T_W_C_prior);
   const MotionFilterOutput filtered =
@@ -58,44 +83,49 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   result.dynamic_mask = filtered.dynamic_mask;
   result.unconfirmed_mask = filtered.unconfirmed_mask;
   result.held_mask = filtered.held_mask;
-  MotionFilterOutput widened = filtered;
+  widened = filtered;
   widened.dynamic_mask = widenedMask(filtered.dynamic_mask);
   result.dynamic_matches = dropDynamic(matches, widened);
   result.tracked_features = static_cast<int>(tracks_.size());
+  return filtered;
+}
 
-  Eigen::Isometry3d T_W_C = T_W_C_pred;
-  if (!initialized_) {
-    result.status = FrameStatus::kLost;
-    result.T_W_C = T_W_last_;
-    tracks_.clear();
-    // The first frame starts the map at the origin; a restart after a long loss starts a new
-    // part of the map where the camera was last seen.
-    result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered, initialMask(gray, widened));
-    if (result.keyframe) {
-      initialized_ = true;
-      lost_streak_ = 0;
-      result.status = FrameStatus::kTracked;
-      result.T_W_C = T_W_last_;
-      result.inliers = static_cast<int>(tracks_.size());
-    }
-  } else if (estimatePose(frame, T_W_C, result.inliers) ||
-             rescuePose(frame, T_W_C, result.inliers)) {
+void Tracker::Impl::startMap(const RgbdFrame& frame, const cv::Mat& gray,
+                             const MotionFilterOutput& filtered, const MotionFilterOutput& widened,
+                             TrackingResult& result) {
+  result.status = FrameStatus::kLost;
+  result.T_W_C = T_W_last_;
+  tracks_.clear();
+  // The first frame starts the map at the origin; a restart after a long loss starts a new
+  // part of the map where the camera was last seen.
+  result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered, initialMask(gray, widened));
+  if (result.keyframe) {
+    initialized_ = true;
+    lost_streak_ = 0;
     result.status = FrameStatus::kTracked;
-  } else if (relocalize(frame, gray, widened.dynamic_mask, T_W_C, result.inliers) ||
-             (!held_.empty() &&
-              relocalize(frame, gray, certainMask(widened), T_W_C, result.inliers))) {
-    result.status = FrameStatus::kRelocalized;
-  } else {
-    result.status = FrameStatus::kLost;
+    result.T_W_C = T_W_last_;
+    result.inliers = static_cast<int>(tracks_.size());
   }
+}
 
-  if (initialized_ && result.status != FrameStatus::kLost && !result.keyframe) {
-    result.T_W_C = T_W_C;
-    // Held-back objects (a teddy taken for a person) are no movers: they do not count.
-    if (needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
-      result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
-    }
+// The pose from the tracks outside the movers; failing that, with the held-back tracks added;
+// failing that, relocalized against the map outside the (widened) mask, then outside the movers
+// with evidence of their own only.
+FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray,
+                                     const MotionFilterOutput& widened, Eigen::Isometry3d& T_W_C,
+                                     int& inliers) {
+  if (estimatePose(frame, T_W_C, inliers) || rescuePose(frame, T_W_C, inliers)) {
+    return FrameStatus::kTracked;
   }
+  if (relocalize(frame, gray, widened.dynamic_mask, T_W_C, inliers) ||
+      (!held_.empty() && relocalize(frame, gray, certainMask(widened), T_W_C, inliers))) {
+    return FrameStatus::kRelocalized;
+  }
+  return FrameStatus::kLost;
+}
+
+void Tracker::Impl::commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkPyramid pyramid,
+                                TrackingResult& result) {
   if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);
   dropped_.clear();
   if (result.status == FrameStatus::kLost) {
@@ -118,7 +148,6 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   refillProbes(gray);
   // A grey input is used as is: copy it so the caller may reuse its buffer.
   prev_gray_ = gray.data == frame.bgr.data ? gray.clone() : gray;
-  return result;
 }
 
 // A frame without depth (a colour frame with no depth frame near it, a blank depth image) is

@@ -48,6 +48,23 @@ class Tracker::Impl {
 
  private:
   TrackingResult poseWithoutDepth(const RgbdFrame& frame);
+  /// The motion filter (against priorPose() when it holds) and the tracks on its movers
+  /// dropped; the filter's masks and counts into `result`, its output returned and, with the
+  /// mask grown by dynamic_margin_px, in `widened`.
+  MotionFilterOutput removeMovers(const RgbdFrame& frame, const cv::Mat& gray,
+                                  const FeatureMatches& matches,
+                                  const Eigen::Isometry3d& T_W_C_pred, MotionFilterOutput& widened,
+                                  TrackingResult& result);
+  /// A map's first keyframe where the camera was last seen (kLost if it cannot be made).
+  void startMap(const RgbdFrame& frame, const cv::Mat& gray, const MotionFilterOutput& filtered,
+                const MotionFilterOutput& widened, TrackingResult& result);
+  /// The frame's pose with its fallbacks (held-back tracks, relocalization).
+  FrameStatus solvePose(const RgbdFrame& frame, const cv::Mat& gray,
+                        const MotionFilterOutput& widened, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The frame's outcome into the tracker's state: landmarks culled, velocity or loss, records,
+  /// the frame kept as the next one's previous.
+  void commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkPyramid pyramid,
+                   TrackingResult& result);
   Eigen::Isometry3d predictPose() const;
   void matchFeatures(const LkPyramid& cur, const Eigen::Isometry3d& T_W_C_pred,
                      FeatureMatches& matches);
