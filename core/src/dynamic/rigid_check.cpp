@@ -148,6 +148,85 @@ PoseFit fitPose(const std::vector<cv::Point3f>& X, const std::vector<cv::Point2f
   return refinePose(X, p, w, K, threshold_px, f);
 }
 
+/// The current frame's matches lifted to 3-D with its depth.
+struct LiftedPoints {
+  std::vector<cv::Point3f> X;  ///< per match, in the current camera (0 without depth)
+  std::vector<float> z;        ///< per match: its stable measured depth (0 = none)
+  std::vector<int> fit;        ///< bucketed subset with depth (at most 2 per cell)
+};
+
+LiftedPoints liftPoints(const std::vector<cv::Point2f>& cur_px, std::size_t n,
+                        const cv::Mat& depth_m, const cv::Vec4d& K, int bucket_px) {
+  LiftedPoints l;
+  l.X.resize(n);
+  l.z.resize(n);
+  std::map<std::pair<int, int>, int> cells;
+  const int bucket = std::max(1, bucket_px);
+  for (std::size_t i = 0; i < n; ++i) {
+    l.z[i] = stableDepth(depth_m, cur_px[i]);
+    // Points beyond the depth range join the fit as far points (they pin the rotation, which a
+    // near, nearly planar static layer leaves ambiguous with translation); their residual
+    // is the epipolar distance.
+    const float z_fit =
+        l.z[i] > 0.f ? l.z[i] : (beyondRange(depth_m, cur_px[i]) ? kFarDepthM : 0.f);
+    l.X[i] = cv::Point3f(static_cast<float>((cur_px[i].x - K[2]) * z_fit / K[0]),
+                         static_cast<float>((cur_px[i].y - K[3]) * z_fit / K[1]), z_fit);
+    if (z_fit <= 0.f) continue;
+    auto& c = cells[{cvFloor(cur_px[i].x / bucket), cvFloor(cur_px[i].y / bucket)}];
+    if (c++ < 2) l.fit.push_back(static_cast<int>(i));
+  }
+  return l;
+}
+
+/// The camera motion fitted (fitPose()) on the bucketed subset, each match with its weight.
+PoseFit fitBackground(const LiftedPoints& l, const std::vector<cv::Point2f>& prev_px,
+                      const std::vector<float>& fit_weight, const cv::Matx33d& Km,
+                      const EpipolarOptions& o, const RigidMotion* prior) {
+  std::vector<cv::Point3f> fx;
+  std::vector<cv::Point2f> fp;
+  std::vector<float> fw;
+  for (int i : l.fit) {
+    fx.push_back(l.X[i]), fp.push_back(prev_px[i]);
+    fw.push_back(static_cast<std::size_t>(i) < fit_weight.size() ? fit_weight[i] : 1.f);
+  }
+  const double fit_thr = 0.5 * o.reprojection_threshold_px;
+  return fitPose(fx, fp, fw, Km, fit_thr, o.ransac_iterations, prior);
+}
+
+/// F of the pose (previous -> current): X_cur = R^T (X_prev - t).
+cv::Matx33d fundamentalOf(const PoseFit& pose, const cv::Matx33d& Km) {
+  cv::Matx33d R;
+  cv::Rodrigues(pose.rvec, R);
+  const cv::Vec3d t(pose.tvec.at<double>(0), pose.tvec.at<double>(1), pose.tvec.at<double>(2));
+  const cv::Matx33d Rc = R.t();
+  const cv::Vec3d tc = -(Rc * t);
+  const cv::Matx33d tx(0, -tc[2], tc[1], tc[2], 0, -tc[0], -tc[1], tc[0], 0);
+  const cv::Matx33d Kinv = Km.inv();
+  return Kinv.t() * tx * Rc * Kinv;
+}
+
+/// Each match's residual against the pose: reprojection error with depth, epipolar distance
+/// without; flagged beyond its threshold.
+void flagByPose(const LiftedPoints& l, const std::vector<cv::Point2f>& prev_px,
+                const std::vector<cv::Point2f>& cur_px, const PoseFit& pose, const cv::Matx33d& Km,
+                const EpipolarOptions& o, EpipolarResult& r) {
+  const cv::Matx33d F = fundamentalOf(pose, Km);
+  r.model = EpipolarModel::kRigid;
+  r.from_prior = pose.from_prior;
+  r.F = cv::Mat(F).clone();
+  std::vector<cv::Point2f> proj;
+  cv::projectPoints(l.X, pose.rvec, pose.tvec, Km, cv::noArray(), proj);
+  for (std::size_t i = 0; i < l.X.size(); ++i) {
+    if (l.z[i] > 0.f) {
+      r.residual_px[i] = static_cast<float>(cv::norm(proj[i] - prev_px[i]));
+      r.is_dynamic[i] = r.residual_px[i] > o.reprojection_threshold_px;
+    } else {
+      r.residual_px[i] = static_cast<float>(symmetricEpipolarDistance(F, prev_px[i], cur_px[i]));
+      r.is_dynamic[i] = r.residual_px[i] > o.rigid_epipolar_threshold_px;
+    }
+  }
+}
+
 }  // namespace
 
 EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
@@ -166,68 +245,20 @@ EpipolarResult checkRigidMotion(const std::vector<cv::Point2f>& prev_px,
   // No median-parallax guard: with depth a still camera is well-conditioned (PnP), and a walker
   // seen from it must be found. Only a repeated frame (nothing moved) says nothing (kNone).
   if (nothingMoved(prev_px, cur_px, o.min_parallax_px)) return r;
-
-  std::vector<cv::Point3f> X(n);
-  std::vector<float> z(n);
-  std::vector<int> fit;  // bucketed subset with depth
-  std::map<std::pair<int, int>, int> cells;
-  const int bucket = std::max(1, o.bucket_px);
-  for (std::size_t i = 0; i < n; ++i) {
-    z[i] = stableDepth(depth_m, cur_px[i]);
-    // Points beyond the depth range join the fit as far points (they pin the rotation, which a
-    // near, nearly planar static layer leaves ambiguous with translation); their residual
-    // is the epipolar distance.
-    const float z_fit = z[i] > 0.f ? z[i] : (beyondRange(depth_m, cur_px[i]) ? kFarDepthM : 0.f);
-    X[i] = cv::Point3f(static_cast<float>((cur_px[i].x - K[2]) * z_fit / K[0]),
-                       static_cast<float>((cur_px[i].y - K[3]) * z_fit / K[1]), z_fit);
-    if (z_fit <= 0.f) continue;
-    auto& c = cells[{cvFloor(cur_px[i].x / bucket), cvFloor(cur_px[i].y / bucket)}];
-    if (c++ < 2) fit.push_back(static_cast<int>(i));
-  }
+  const LiftedPoints l = liftPoints(cur_px, n, depth_m, K, o.bucket_px);
   // Far points only pin the rotation of a fit made of measured depth: with too little depth
   // (mostly invalid pixels) every point would look "far" and the fit would treat a near scene as
   // if it were 12 m away.
-  const auto measured = std::count_if(fit.begin(), fit.end(), [&](int i) { return z[i] > 0.f; });
+  const auto measured =
+      std::count_if(l.fit.begin(), l.fit.end(), [&](int i) { return l.z[i] > 0.f; });
   if (measured < kMinFitPoints) return checkEpipolar(prev_px, cur_px, o);
-
-  std::vector<cv::Point3f> fx;
-  std::vector<cv::Point2f> fp;
-  std::vector<float> fw;
-  for (int i : fit) {
-    fx.push_back(X[i]), fp.push_back(prev_px[i]);
-    fw.push_back(static_cast<std::size_t>(i) < fit_weight.size() ? fit_weight[i] : 1.f);
-  }
   const cv::Matx33d Km(K[0], 0, K[2], 0, K[1], K[3], 0, 0, 1);
-  const double fit_thr = 0.5 * o.reprojection_threshold_px;
-  PoseFit best = fitPose(fx, fp, fw, Km, fit_thr, o.ransac_iterations, prior);
+  const PoseFit best = fitBackground(l, prev_px, fit_weight, Km, o, prior);
   if (!best.ok) return checkEpipolar(prev_px, cur_px, o);
-  const cv::Mat& rvec = best.rvec;
-  const cv::Mat& tvec = best.tvec;
-  if (estimated != nullptr) *estimated = RigidMotion{cv::Vec3d(rvec), cv::Vec3d(tvec), true};
-
-  // F of the pose (previous -> current): X_cur = R^T (X_prev - t).
-  cv::Matx33d R;
-  cv::Rodrigues(rvec, R);
-  const cv::Vec3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  const cv::Matx33d Rc = R.t();
-  const cv::Vec3d tc = -(Rc * t);
-  const cv::Matx33d tx(0, -tc[2], tc[1], tc[2], 0, -tc[0], -tc[1], tc[0], 0);
-  const cv::Matx33d Kinv = Km.inv();
-  const cv::Matx33d F = Kinv.t() * tx * Rc * Kinv;
-  r.model = EpipolarModel::kRigid;
-  r.from_prior = best.from_prior;
-  r.F = cv::Mat(F).clone();
-  std::vector<cv::Point2f> proj;
-  cv::projectPoints(X, rvec, tvec, Km, cv::noArray(), proj);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (z[i] > 0.f) {
-      r.residual_px[i] = static_cast<float>(cv::norm(proj[i] - prev_px[i]));
-      r.is_dynamic[i] = r.residual_px[i] > o.reprojection_threshold_px;
-    } else {
-      r.residual_px[i] = static_cast<float>(symmetricEpipolarDistance(F, prev_px[i], cur_px[i]));
-      r.is_dynamic[i] = r.residual_px[i] > o.rigid_epipolar_threshold_px;
-    }
+  if (estimated != nullptr) {
+    *estimated = RigidMotion{cv::Vec3d(best.rvec), cv::Vec3d(best.tvec), true};
   }
+  flagByPose(l, prev_px, cur_px, best, Km, o, r);
   return r;
 }
 
