@@ -43,6 +43,129 @@ openvdb::Coord leafOf(const Eigen::Vector3d& p_W, double inv_voxel) {
   return openvdb::Coord(idx(p_W.x()), idx(p_W.y()), idx(p_W.z()));
 }
 
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
+
+/// Per block, its leaf in each grid (free: empty without free votes).
+struct GridLeaves {
+  std::vector<FloatLeaf*> tsdf, weight, free;
+  std::vector<ColorLeaf*> color;
+};
+
+/// The leaves of `blocks` in each grid, created where missing (`free` null: not used). Each
+/// grid's tree is touched by one thread (trees are not safe for concurrent writes).
+GridLeaves touchLeaves(const std::vector<openvdb::Coord>& blocks, openvdb::FloatGrid& tsdf,
+                       openvdb::FloatGrid& weight, openvdb::Vec3SGrid& color,
+                       openvdb::FloatGrid* free) {
+  GridLeaves leaves;
+  leaves.tsdf.resize(blocks.size());
+  leaves.weight.resize(blocks.size());
+  leaves.color.resize(blocks.size());
+  leaves.free.resize(free != nullptr ? blocks.size() : 0);
+  auto touch = [&blocks](auto& grid, auto& out) {
+    auto acc = grid.getAccessor();
+    for (std::size_t i = 0; i < blocks.size(); ++i) out[i] = acc.touchLeaf(blocks[i]);
+  };
+  tbb::parallel_invoke([&] { touch(tsdf, leaves.tsdf); }, [&] { touch(weight, leaves.weight); },
+                       [&] { touch(color, leaves.color); },
+                       [&] {
+                         if (free != nullptr) touch(*free, leaves.free);
+                       });
+  return leaves;
+}
+
+/// One block's leaves (free: null without free votes).
+struct BlockLeaves {
+  FloatLeaf& tsdf;
+  FloatLeaf& weight;
+  ColorLeaf& color;
+  FloatLeaf* free;
+};
+
+/// Voxel (index coordinates) -> camera point -> depth-image pixel, in float.
+struct VoxelProjector {
+  Eigen::Matrix3f R;       ///< of T_C_W
+  Eigen::Vector3f t;       ///< of T_C_W
+  Eigen::Vector3f step_z;  ///< one voxel along the world z axis, in the camera
+  float vs, trunc, fx, fy, cx, cy, cols, rows;
+};
+
+VoxelProjector makeProjector(const PinholeCamera& camera, const Eigen::Isometry3d& T_W_C,
+                             const TsdfOptions& options, const cv::Size& image) {
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  VoxelProjector p;
+  p.R = T_C_W.rotation().cast<float>();
+  p.t = T_C_W.translation().cast<float>();
+  p.vs = static_cast<float>(options.voxel_size_m);
+  p.trunc = static_cast<float>(options.truncation_m);
+  p.fx = static_cast<float>(camera.fx), p.fy = static_cast<float>(camera.fy);
+  p.cx = static_cast<float>(camera.cx), p.cy = static_cast<float>(camera.cy);
+  p.step_z = p.R.col(2) * p.vs;
+  p.cols = static_cast<float>(image.width), p.rows = static_cast<float>(image.height);
+  return p;
+}
+
+/// Fuses one observation, signed distance `sdf` (within -trunc..), into voxel n of the block;
+/// `colour`: the pixel's, or null.
+void updateVoxel(const BlockLeaves& leaves, openvdb::Index n, float sdf, float trunc,
+                 const cv::Vec3b* colour, const TsdfOptions& options) {
+  FloatLeaf* fl = leaves.free;
+  if (fl != nullptr && sdf > trunc) {
+    fl->setValueOn(n, fl->getValue(n) + 1.0f);
+    return;
+  }
+  const float w_old = leaves.weight.getValue(n);
+  const float obs = std::min(1.0f, sdf / trunc);
+  float w = 1.0f;
+  if (options.linear_weighting && sdf < 0.0f) w = std::max(0.05f, 1.0f + sdf / trunc);
+  const float w_sum = w_old + w;
+  const float w_new = std::min(w_sum, options.max_weight);
+  leaves.tsdf.setValueOn(n, (leaves.tsdf.getValue(n) * w_old + obs * w) / w_sum);
+  leaves.weight.setValueOn(n, w_new);
+  if (fl != nullptr && w_sum > w_new) {
+    // The weight stopped at max_weight; the vote still counts this view (see votedTsdf).
+    fl->setValueOn(n, fl->getValue(n) - options.free_vote_ratio * (w_sum - w_new));
+  }
+  if (colour != nullptr && std::fabs(sdf) < trunc) {
+    const cv::Vec3b& p = *colour;
+    const openvdb::Vec3s c_new(p[2], p[1], p[0]);
+    leaves.color.setValueOn(n, (leaves.color.getValue(n) * w_old + c_new * w) / (w_old + w));
+  }
+}
+
+/// The 8 voxels of the block's column (x, y) projected into the depth image and fused.
+void integrateColumn(const BlockLeaves& leaves, const openvdb::Coord& o, int x, int y,
+                     const VoxelProjector& p, const cv::Mat& depth_m, const cv::Mat& bgr,
+                     bool has_colour, const TsdfOptions& options) {
+  // The column's 8 voxels: their camera points one step apart (summed in order), then their
+  // projections side by side (no branch: the compiler does 4 at a time), then the checks and
+  // updates one by one.
+  std::array<float, kLeafDim> px, py, pz, uf, vf;
+  Eigen::Vector3f p_C = p.R * (Eigen::Vector3f(o.x() + x, o.y() + y, o.z()) * p.vs) + p.t;
+  for (int z = 0; z < kLeafDim; ++z, p_C += p.step_z) {
+    px[z] = p_C.x();
+    py[z] = p_C.y();
+    pz[z] = p_C.z();
+  }
+  for (int z = 0; z < kLeafDim; ++z) {
+    const float inv_z = 1.0f / pz[z];
+    uf[z] = p.fx * px[z] * inv_z + p.cx + 0.5f;
+    vf[z] = p.fy * py[z] * inv_z + p.cy + 0.5f;
+  }
+  for (int z = 0; z < kLeafDim; ++z) {
+    if (pz[z] <= 0.05f) continue;
+    // static_cast<int> truncates: the pixel is inside iff -1 < uf < cols (NaN is not).
+    if (!(uf[z] > -1.0f && vf[z] > -1.0f && uf[z] < p.cols && vf[z] < p.rows)) continue;
+    const int u = static_cast<int>(uf[z]), v = static_cast<int>(vf[z]);
+    const float d = depth_m.at<float>(v, u);
+    if (!(d > 0.0f)) continue;
+    const float sdf = d - pz[z];
+    if (sdf < -p.trunc) continue;
+    const openvdb::Index n = (x << 6) | (y << 3) | z;
+    updateVoxel(leaves, n, sdf, p.trunc, has_colour ? &bgr.at<cv::Vec3b>(v, u) : nullptr, options);
+  }
+}
+
 }  // namespace
 
 TsdfVolume::TsdfVolume(const TsdfOptions& options) : options_(options) {
@@ -138,88 +261,17 @@ std::vector<openvdb::Coord> TsdfVolume::collectBlocks(const PinholeCamera& camer
 void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
                            const Eigen::Isometry3d& T_W_C) {
   const std::vector<openvdb::Coord> blocks = collectBlocks(camera, depth_m, T_W_C);
-  using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-  using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
-  std::vector<FloatLeaf*> tsdf_leaves(blocks.size());
-  std::vector<FloatLeaf*> weight_leaves(blocks.size());
-  std::vector<ColorLeaf*> color_leaves(blocks.size());
-  std::vector<FloatLeaf*> free_leaves(options_.free_votes ? blocks.size() : 0);
-  // Each grid's tree is touched by one thread (trees are not safe for concurrent writes).
-  auto touch = [&blocks](auto& grid, auto& leaves) {
-    auto acc = grid.getAccessor();
-    for (std::size_t i = 0; i < blocks.size(); ++i) leaves[i] = acc.touchLeaf(blocks[i]);
-  };
-  tbb::parallel_invoke([&] { touch(*tsdf_, tsdf_leaves); }, [&] { touch(*weight_, weight_leaves); },
-                       [&] { touch(*color_, color_leaves); },
-                       [&] {
-                         if (options_.free_votes) touch(*free_, free_leaves);
-                       });
-  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
-  const Eigen::Matrix3f R = T_C_W.rotation().cast<float>();
-  const Eigen::Vector3f t = T_C_W.translation().cast<float>();
-  const auto vs = static_cast<float>(options_.voxel_size_m);
-  const auto trunc = static_cast<float>(options_.truncation_m);
-  const auto fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
-  const auto cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const GridLeaves leaves =
+      touchLeaves(blocks, *tsdf_, *weight_, *color_, options_.free_votes ? free_.get() : nullptr);
+  const VoxelProjector projector = makeProjector(camera, T_W_C, options_, depth_m.size());
   const bool has_colour = !bgr.empty() && bgr.size() == depth_m.size();
-  const Eigen::Vector3f step_z = R.col(2) * vs;
-  const auto cols = static_cast<float>(depth_m.cols), rows = static_cast<float>(depth_m.rows);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
     for (std::size_t b = range.begin(); b < range.end(); ++b) {
-      FloatLeaf& tl = *tsdf_leaves[b];
-      FloatLeaf& wl = *weight_leaves[b];
-      ColorLeaf& cl = *color_leaves[b];
-      FloatLeaf* fl = options_.free_votes ? free_leaves[b] : nullptr;
-      const openvdb::Coord o = blocks[b];
+      const BlockLeaves block{*leaves.tsdf[b], *leaves.weight[b], *leaves.color[b],
+                              options_.free_votes ? leaves.free[b] : nullptr};
       for (int x = 0; x < kLeafDim; ++x) {
         for (int y = 0; y < kLeafDim; ++y) {
-          // The column's 8 voxels: their camera points one step apart (summed in order), then
-          // their projections side by side (no branch: the compiler does 4 at a time), then
-          // the checks and updates one by one.
-          std::array<float, kLeafDim> px, py, pz, uf, vf;
-          Eigen::Vector3f p_C = R * (Eigen::Vector3f(o.x() + x, o.y() + y, o.z()) * vs) + t;
-          for (int z = 0; z < kLeafDim; ++z, p_C += step_z) {
-            px[z] = p_C.x();
-            py[z] = p_C.y();
-            pz[z] = p_C.z();
-          }
-          for (int z = 0; z < kLeafDim; ++z) {
-            const float inv_z = 1.0f / pz[z];
-            uf[z] = fx * px[z] * inv_z + cx + 0.5f;
-            vf[z] = fy * py[z] * inv_z + cy + 0.5f;
-          }
-          for (int z = 0; z < kLeafDim; ++z) {
-            if (pz[z] <= 0.05f) continue;
-            // static_cast<int> truncates: the pixel is inside iff -1 < uf < cols (NaN is not).
-            if (!(uf[z] > -1.0f && vf[z] > -1.0f && uf[z] < cols && vf[z] < rows)) continue;
-            const int u = static_cast<int>(uf[z]), v = static_cast<int>(vf[z]);
-            const float d = depth_m.at<float>(v, u);
-            if (!(d > 0.0f)) continue;
-            const float sdf = d - pz[z];
-            if (sdf < -trunc) continue;
-            const openvdb::Index n = (x << 6) | (y << 3) | z;
-            if (fl != nullptr && sdf > trunc) {
-              fl->setValueOn(n, fl->getValue(n) + 1.0f);
-              continue;
-            }
-            const float w_old = wl.getValue(n);
-            const float obs = std::min(1.0f, sdf / trunc);
-            float w = 1.0f;
-            if (options_.linear_weighting && sdf < 0.0f) w = std::max(0.05f, 1.0f + sdf / trunc);
-            const float w_sum = w_old + w;
-            const float w_new = std::min(w_sum, options_.max_weight);
-            tl.setValueOn(n, (tl.getValue(n) * w_old + obs * w) / w_sum);
-            wl.setValueOn(n, w_new);
-            if (fl != nullptr && w_sum > w_new) {
-              // The weight stopped at max_weight; the vote still counts this view (see votedTsdf).
-              fl->setValueOn(n, fl->getValue(n) - options_.free_vote_ratio * (w_sum - w_new));
-            }
-            if (has_colour && std::fabs(sdf) < trunc) {
-              const cv::Vec3b p = bgr.at<cv::Vec3b>(v, u);
-              const openvdb::Vec3s c_new(p[2], p[1], p[0]);
-              cl.setValueOn(n, (cl.getValue(n) * w_old + c_new * w) / (w_old + w));
-            }
-          }
+          integrateColumn(block, blocks[b], x, y, projector, depth_m, bgr, has_colour, options_);
         }
       }
     }
