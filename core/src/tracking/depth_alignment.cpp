@@ -1,0 +1,156 @@
+#include "dynamap/core/tracking/depth_alignment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+namespace dynamap {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+bool usable(const cv::Mat& mask, int x, int y) { return mask.empty() || mask.at<uchar>(y, x) == 0; }
+
+/// The static points of the current image, in its camera frame.
+std::vector<Eigen::Vector3d> currentPoints(const PosedDepth& current, const PinholeCamera& camera,
+                                           const DepthAlignmentOptions& o) {
+  std::vector<Eigen::Vector3d> points;
+  const int step = std::max(1, o.pixel_stride);
+  for (int y = step / 2; y < current.depth_m.rows; y += step) {
+    const float* row = current.depth_m.ptr<float>(y);
+    for (int x = step / 2; x < current.depth_m.cols; x += step) {
+      const double z = row[x];
+      if (z >= o.min_depth_m && z <= o.max_depth_m && usable(current.moving_mask, x, y)) {
+        points.push_back(camera.backProject(x, y, z));
+      }
+    }
+  }
+  return points;
+}
+
+/// The reference surface at a pixel: its point and unit normal (from the neighbours two pixels
+/// away), none where a neighbour is missing, masked, or across a depth step.
+struct SurfacePoint {
+  Eigen::Vector3d point, normal;
+};
+
+bool surfaceAt(const PosedDepth& ref, const PinholeCamera& camera, const DepthAlignmentOptions& o,
+               int x, int y, SurfacePoint& out) {
+  constexpr int kReach = 2;
+  if (x < kReach || y < kReach || x >= ref.depth_m.cols - kReach ||
+      y >= ref.depth_m.rows - kReach || !usable(ref.moving_mask, x, y)) {
+    return false;
+  }
+  const auto depth = [&](int u, int v) { return static_cast<double>(ref.depth_m.at<float>(v, u)); };
+  const double z = depth(x, y);
+  if (!(z >= o.min_depth_m && z <= o.max_depth_m)) return false;
+  const double zl = depth(x - kReach, y), zr = depth(x + kReach, y);
+  const double zu = depth(x, y - kReach), zd = depth(x, y + kReach);
+  const double step = 0.05 * z;
+  for (const double n : {zl, zr, zu, zd}) {
+    if (!(n > 0.0) || std::abs(n - z) > step) return false;
+  }
+  const Eigen::Vector3d dx = camera.backProject(x + kReach, y, zr) -
+                             camera.backProject(x - kReach, y, zl);
+  const Eigen::Vector3d dy = camera.backProject(x, y + kReach, zd) -
+                             camera.backProject(x, y - kReach, zu);
+  const Eigen::Vector3d normal = dx.cross(dy);
+  if (normal.norm() < 1e-12) return false;
+  out.point = camera.backProject(x, y, z);
+  out.normal = normal.normalized();
+  return true;
+}
+
+/// One association and linearisation pass: H, b of the point-to-plane residuals n.(T p - r)
+/// (twist on the left, in the reference frame), and the residuals of the associated points.
+struct Linearisation {
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d b = Vector6d::Zero();
+  std::vector<double> residuals;
+};
+
+Linearisation linearise(const PosedDepth& ref, const std::vector<Eigen::Vector3d>& points,
+                        const Eigen::Isometry3d& T_R_C, const PinholeCamera& camera,
+                        const DepthAlignmentOptions& o, double gate_m) {
+  Linearisation lin;
+  SurfacePoint surface;
+  for (const Eigen::Vector3d& p_C : points) {
+    const Eigen::Vector3d q = T_R_C * p_C;
+    if (q.z() <= 0.0) continue;
+    const Eigen::Vector2d px = camera.project(q);
+    const int x = static_cast<int>(std::lround(px.x())), y = static_cast<int>(std::lround(px.y()));
+    if (!surfaceAt(ref, camera, o, x, y, surface)) continue;
+    if ((q - surface.point).norm() > gate_m) continue;
+    const double e = surface.normal.dot(q - surface.point);
+    Vector6d J;
+    J << surface.normal, q.cross(surface.normal);
+    const double w = std::abs(e) <= o.huber_m ? 1.0 : o.huber_m / std::abs(e);
+    lin.H += w * J * J.transpose();
+    lin.b += w * e * J;
+    lin.residuals.push_back(e);
+  }
+  return lin;
+}
+
+Eigen::Isometry3d twistToPose(const Vector6d& xi) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d w = xi.tail<3>();
+  if (w.norm() > 0.0) T.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+  T.translation() = xi.head<3>();
+  return T;
+}
+
+/// The smallest eigenvalue of the translation block of the normal equations.
+double weakestDirectionPoints(const Matrix6d& H) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(H.topLeftCorner<3, 3>());
+  return solver.eigenvalues().minCoeff();
+}
+
+void scoreResult(const Linearisation& lin, const DepthAlignmentOptions& o, DepthAlignment& out) {
+  double sum_sq = 0.0;
+  for (const double e : lin.residuals) {
+    if (std::abs(e) <= o.inlier_m) {
+      ++out.inliers;
+      sum_sq += e * e;
+    }
+  }
+  const double associated = static_cast<double>(lin.residuals.size());
+  out.inlier_share = associated > 0 ? out.inliers / associated : 0.0;
+  out.rms_m = out.inliers > 0 ? std::sqrt(sum_sq / out.inliers) : 0.0;
+  out.weakest_direction_points = weakestDirectionPoints(lin.H);
+  out.accepted = out.inliers >= o.min_inliers && out.inlier_share >= o.min_inlier_share &&
+                 out.weakest_direction_points >= o.min_weakest_direction_points;
+}
+
+}  // namespace
+
+DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current,
+                          const PinholeCamera& camera, const DepthAlignmentOptions& o) {
+  DepthAlignment out;
+  out.T_W_C = current.T_W_C;
+  if (reference.depth_m.type() != CV_32FC1 || current.depth_m.type() != CV_32FC1) return out;
+  const std::vector<Eigen::Vector3d> points = currentPoints(current, camera, o);
+  Eigen::Isometry3d T_R_C = reference.T_W_C.inverse() * current.T_W_C;
+  const int iterations = std::max(1, o.max_iterations);
+  for (int it = 0; it < iterations; ++it) {
+    const double a = iterations > 1 ? static_cast<double>(it) / (iterations - 1) : 1.0;
+    const double gate = o.start_gate_m * std::pow(o.end_gate_m / o.start_gate_m, a);
+    const Linearisation lin = linearise(reference, points, T_R_C, camera, o, gate);
+    if (lin.residuals.size() < 6) return out;
+    const Vector6d xi = lin.H.ldlt().solve(-lin.b);
+    if (!xi.allFinite()) return out;
+    T_R_C = twistToPose(xi) * T_R_C;
+    if (xi.head<3>().norm() < 1e-5 && xi.tail<3>().norm() < 1e-5 && gate <= o.end_gate_m * 1.5) {
+      break;
+    }
+  }
+  const Linearisation last = linearise(reference, points, T_R_C, camera, o, o.end_gate_m);
+  out.T_W_C = reference.T_W_C * T_R_C;
+  scoreResult(last, o, out);
+  return out;
+}
+
+}  // namespace dynamap
