@@ -1,6 +1,7 @@
 #include "dynamap/core/tracker.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
@@ -61,8 +62,9 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     result.status = solvePose(frame, gray, widened, T_W_C, result.inliers);
     if (result.status != FrameStatus::kLost) {
       result.T_W_C = T_W_C;
-      // Held-back objects (a teddy taken for a person) are no movers: they do not count.
-      if (needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
+      // Held-back objects (a teddy taken for a person) are no movers: they do not count. A pose
+      // from depth alone bridges the frame: its features (few, near the movers) make no keyframe.
+      if (!posed_by_depth_ && needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
         result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
       }
     }
@@ -110,10 +112,12 @@ void Tracker::Impl::startMap(const RgbdFrame& frame, const cv::Mat& gray,
 
 // The pose from the tracks outside the movers; failing that, with the held-back tracks added;
 // failing that, relocalized against the map outside the (widened) mask, then outside the movers
-// with evidence of their own only.
+// with evidence of their own only; failing that, from the depth of the static pixels aligned to
+// the last frame's (a view filled by people, where no features are left to relocalize with).
 FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray,
                                      const MotionFilterOutput& widened, Eigen::Isometry3d& T_W_C,
                                      int& inliers) {
+  posed_by_depth_ = false;
   if (estimatePose(frame, T_W_C, inliers) || rescuePose(frame, T_W_C, inliers)) {
     return FrameStatus::kTracked;
   }
@@ -121,25 +125,53 @@ FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray
       (!held_.empty() && relocalize(frame, gray, certainMask(widened), T_W_C, inliers))) {
     return FrameStatus::kRelocalized;
   }
-  return FrameStatus::kLost;
+  posed_by_depth_ = alignToLastDepth(frame, widened.dynamic_mask, T_W_C);
+  return posed_by_depth_ ? FrameStatus::kTracked : FrameStatus::kLost;
+}
+
+// The dense fallback: the static depth aligned to the last tracked frame's, from the predicted
+// pose; used only when the geometry pins the pose down and it stays near the prediction.
+bool Tracker::Impl::alignToLastDepth(const RgbdFrame& frame, const cv::Mat& moving_mask,
+                                     Eigen::Isometry3d& T_W_C) {
+  if (!config_.depth_fallback || !last_tracked_ || last_depth_.depth_m.empty()) return false;
+  ScopedStageTimer timer(timings_, "depth_alignment");
+  PosedDepth reference = last_depth_;
+  if (!reference.moving_mask.empty()) reference.moving_mask = widenedMask(reference.moving_mask);
+  const PosedDepth current{frame.depth_m, moving_mask, predictPose()};
+  const DepthAlignment aligned = alignDepth(reference, current, camera_);
+  const Eigen::Isometry3d step = current.T_W_C.inverse() * aligned.T_W_C;
+  constexpr double kMaxStepM = 0.2, kMaxStepRad = 15.0 * M_PI / 180.0;
+  if (!aligned.accepted || step.translation().norm() > kMaxStepM ||
+      Eigen::AngleAxisd(step.linear()).angle() > kMaxStepRad) {
+    return false;
+  }
+  T_W_C = aligned.T_W_C;
+  return true;
 }
 
 void Tracker::Impl::commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkPyramid pyramid,
                                 TrackingResult& result) {
   if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);
   dropped_.clear();
+  // The tracks of a frame posed by depth alone failed to give its pose: the next frame starts
+  // afresh, as after a lost one, but from this pose.
+  if (posed_by_depth_) tracks_.clear();
+  const int restart = config_.restart_after_lost_frames;
   if (result.status == FrameStatus::kLost) {
     result.T_W_C = T_W_last_;
     tracks_.clear();
     last_tracked_ = false;
     // Lost for long (relocalization keeps failing, e.g. the map's texture is masked): restart.
-    const int restart = config_.restart_after_lost_frames;
     if (initialized_ && restart > 0 && ++lost_streak_ >= restart) initialized_ = false;
   } else {
-    lost_streak_ = 0;
+    // Frames posed by depth alone count as lost for the restart: the map restarts at their pose.
+    lost_streak_ = posed_by_depth_ ? lost_streak_ + 1 : 0;
+    if (restart > 0 && lost_streak_ >= restart) initialized_ = false;
     velocity_ = last_tracked_ ? T_W_last_.inverse() * result.T_W_C : Eigen::Isometry3d::Identity();
     T_W_last_ = result.T_W_C;
     last_tracked_ = true;
+    // A copy: the caller may reuse its buffers for the next frame.
+    if (config_.depth_fallback) last_depth_ = {frame.depth_m.clone(), result.dynamic_mask, T_W_last_};
   }
   result.is_keyframe = static_cast<bool>(result.keyframe);
   record(frame.timestamp_s, result.status, result.T_W_C);

@@ -111,6 +111,11 @@ struct TrackerConfig {
   /// After this many frames lost in a row the map restarts where the camera was last seen
   /// (0 = never: stay lost until relocalization succeeds).
   int restart_after_lost_frames = 5;
+  /// Where neither the features nor relocalization give the pose (a view filled by people),
+  /// the depth of the frame's static pixels is aligned to the last tracked frame's
+  /// (depth_alignment.hpp); such frames make no keyframe and count as lost for the restart.
+  /// Off: on the Bonn slice it removes every lost frame but raises the ATE (BENCHMARKS.md).
+  bool depth_fallback = false;
 };
 
 }  // namespace dynamap

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "dynamap/core/tracker.hpp"
+#include "dynamap/core/tracking/depth_alignment.hpp"
 #include "dynamap/core/tracking/feature_extractor.hpp"
 #include "dynamap/core/tracking/lk_tracker.hpp"
 #include "dynamap/core/tracking/local_ba.hpp"
@@ -78,6 +79,8 @@ class Tracker::Impl {
   cv::Mat widenedMask(const cv::Mat& dynamic_mask) const;
   /// estimatePose() with the held-back tracks added; tracks_ unchanged if it fails.
   bool rescuePose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C, int& inliers);
+  bool alignToLastDepth(const RgbdFrame& frame, const cv::Mat& moving_mask,
+                        Eigen::Isometry3d& T_W_C);
   /// The mask the first keyframe of a map takes its landmarks outside of.
   cv::Mat initialMask(const cv::Mat& gray, const MotionFilterOutput& out);
   /// `out`'s mask without its unconfirmed objects.
@@ -127,6 +130,8 @@ class Tracker::Impl {
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
+  PosedDepth last_depth_;  ///< the last tracked frame's depth, moving mask and pose
+  bool posed_by_depth_ = false;  ///< this frame's pose came from alignToLastDepth
 
   std::uint64_t ref_kf_ = 0;
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
