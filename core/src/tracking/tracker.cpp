@@ -383,13 +383,14 @@ Tracker::~Tracker() { impl_->ba_.stop(); }
 
 void Tracker::setMotionFilter(MotionFilter* filter) { impl_->filter_ = filter; }
 TrackingResult Tracker::track(const RgbdFrame& frame) { return impl_->track(frame); }
-void Tracker::markBadFrame(double /*timestamp_s*/) { impl_->markBadFrame(); }
+void Tracker::markBadFrame(double timestamp_s) { impl_->markBadFrame(timestamp_s); }
 std::vector<PoseUpdate> Tracker::takePoseUpdates() { return impl_->ba_.takeUpdates(); }
 void Tracker::finish() { impl_->finish(); }
 std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::finalTrajectory() const {
   return impl_->finalTrajectory();
 }
 std::vector<FrameStatus> Tracker::frameStatuses() const { return impl_->frameStatuses(); }
+std::vector<double> Tracker::badFrameTimestamps() const { return impl_->badFrameTimestamps(); }
 std::vector<KeyframeInfo> Tracker::keyframes() const { return impl_->map_.keyframes(); }
 TrackerStats Tracker::stats() const { return impl_->stats(); }
 

@@ -251,7 +251,8 @@ void Tracker::Impl::countStatus(FrameStatus status, bool keyframe) {
   if (keyframe) ++stats_.keyframes;
 }
 
-void Tracker::Impl::markBadFrame() {
+void Tracker::Impl::markBadFrame(double timestamp_s) {
+  bad_frames_.push_back(timestamp_s);
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++stats_.frames;
   ++stats_.bad_frames;

@@ -80,7 +80,9 @@ class Tracker {
   /// frame.bgr CV_8UC3, frame.depth_m CV_32F metres (0 = none). Never throws on bad content:
   /// an unusable frame comes back as kLost with the last known pose.
   TrackingResult track(const RgbdFrame& frame);
-  /// A frame that could not be read: counted, gets kBadFrame, no pose.
+  /// A frame that could not be read: counted (stats().bad_frames), its timestamp kept as a
+  /// kBadFrame (badFrameTimestamps()); it has no pose, so finalTrajectory() and
+  /// frameStatuses() leave it out.
   void markBadFrame(double timestamp_s);
   /// Keyframe poses corrected by BA since the last call. Thread-safe.
   std::vector<PoseUpdate> takePoseUpdates();
@@ -92,6 +94,7 @@ class Tracker {
   /// keyframe recomposed with that keyframe's latest optimised pose.
   std::vector<std::pair<double, Eigen::Isometry3d>> finalTrajectory() const;
   std::vector<FrameStatus> frameStatuses() const;  ///< parallel to finalTrajectory()
+  std::vector<double> badFrameTimestamps() const;  ///< markBadFrame()'s, in call order
   std::vector<KeyframeInfo> keyframes() const;     ///< latest optimised poses
   TrackerStats stats() const;                      ///< thread-safe
 

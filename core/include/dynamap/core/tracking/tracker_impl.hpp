@@ -37,10 +37,11 @@ class Tracker::Impl {
   Impl(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings);
 
   TrackingResult track(const RgbdFrame& frame);
-  void markBadFrame();
+  void markBadFrame(double timestamp_s);
   void finish();
   std::vector<std::pair<double, Eigen::Isometry3d>> finalTrajectory() const;
   std::vector<FrameStatus> frameStatuses() const;
+  std::vector<double> badFrameTimestamps() const { return bad_frames_; }
   TrackerStats stats() const;
 
   MotionFilter* filter_ = nullptr;
@@ -139,6 +140,7 @@ class Tracker::Impl {
   std::size_t ref_tracks_ = 0;
 
   std::vector<FrameRecord> records_;
+  std::vector<double> bad_frames_;  ///< markBadFrame()'s timestamps (frames without a record)
   mutable std::mutex stats_mutex_;
   TrackerStats stats_;
 };
