@@ -85,7 +85,7 @@ class DarknetDetector : public NetDetector {
     requireFile(o.model_weights, "Darknet weights");
     // The size check comes before the probe: a net with uninitialised weights is never run.
     // With the fast paths, its layers are made while the faster convolutions are registered
-    // (core/fast_paths/own_conv_layers.hpp: the same outputs to float rounding).
+    // (core/fast_paths/own_conv_layers.cpp: the same outputs to float rounding).
     load(
         [&] {
 #ifdef DYNAMAP_HAVE_FAST_CONV

@@ -7,7 +7,7 @@
 namespace dynamap {
 
 /// Motion-area removal parameters, bound to YAML keys "dynamic.<name>"
-/// (tools/io/config_bind_dynamic.cpp).
+/// (system/src/config_bind_dynamic.cpp).
 ///
 /// Model paths: an absolute path is used as is. A relative path is resolved by
 /// resolveDynamicModelPaths(): first against the current working directory, then against the
@@ -47,10 +47,11 @@ struct DynamicConfig {
   double score_threshold = 0.25;  ///< low-dynamic classes
   double high_dynamic_score_threshold = 0.15;  ///< high-dynamic classes (recall first)
   double nms_iou_threshold = 0.45;
-  std::string nms = "recall";  ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)
-  double soft_nms_sigma = 0.5;
-  double nms_dedup_iou = 0.7;  ///< recall NMS: duplicates above this IoU are dropped after soft-NMS
-                               ///< ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
+  std::string nms = "recall";   ///< plain (class-wise hard NMS) | recall (class-aware soft-NMS)
+  double soft_nms_sigma = 0.5;  ///< Gaussian soft-NMS: score *= exp(-iou^2 / sigma)
+  /// Recall NMS: meant to drop duplicates above this IoU after soft-NMS, but not applied:
+  /// nms.cpp has no such pass (the option came in c52fd65 without one).
+  double nms_dedup_iou = 0.7;
   /// >0: cv::setNumThreads on first detection (process-wide: OpenCV's pool is global). 1 by
   /// default: on a 2-core machine the detector, tracker, BA and mapper threads already fill both
   /// cores, and a second OpenCV worker per call only adds contention.

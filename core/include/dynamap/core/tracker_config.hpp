@@ -2,8 +2,8 @@
 
 namespace dynamap {
 
-/// Tracking front-end parameters. Defaults live here; tools/ binds them to YAML keys
-/// "tracking.<name>" (tools/io/config_bind_tracking.cpp).
+/// Tracking front-end parameters. Defaults live here; dynamap::system binds them to YAML keys
+/// "tracking.<name>" (system/src/config_bind_tracking.cpp).
 struct TrackerConfig {
   // --- features (ORB over a scale pyramid, spread over a grid) ---
   int orb_features = 1000;         ///< ORB keypoints extracted per (key)frame before gridding

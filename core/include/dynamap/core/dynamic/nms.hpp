@@ -22,9 +22,8 @@ struct NmsOptions {
   NmsKind kind = NmsKind::kRecall;
   float iou_threshold = 0.45f;    ///< hard NMS suppression IoU
   float score_threshold = 0.25f;  ///< plain NMS and low-dynamic classes
-  float soft_sigma = 0.5f;
-  float dedup_iou = 0.7f;  ///< kRecall: after soft-NMS, drop boxes overlapping a kept one more ///<
-                           ///< Gaussian soft-NMS: s *= exp(-iou^2 / sigma)
+  float soft_sigma = 0.5f;        ///< Gaussian soft-NMS: s *= exp(-iou^2 / sigma)
+  float dedup_iou = 0.7f;         ///< kRecall: not applied yet (no pass after soft-NMS uses it)
   std::vector<float> class_score_threshold;  ///< kRecall: per class (empty = score_threshold)
 };
 
