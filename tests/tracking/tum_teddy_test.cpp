@@ -4,13 +4,12 @@
 
 #include <algorithm>
 #include <iostream>
-#include <map>
-
-#include <opencv2/imgcodecs.hpp>
+#include <vector>
 
 #include "dynamap/core/tracker.hpp"
 #include "test_paths.hpp"
-#include "tracking_test_utils.hpp"
+#include "trajectory_eval.hpp"
+#include "tum_dataset.hpp"
 
 namespace dynamap {
 namespace {
@@ -22,29 +21,21 @@ std::filesystem::path teddyDir() {
   return test::sharedData() / "tum" / "rgbd_dataset_freiburg3_teddy";
 }
 
-/// The associated colour/depth frames among the first kRgbEntries colour images (depth by
-/// nearest timestamp within kMaxDtS). Loaded once per test binary.
+/// The associated colour/depth frames among the first kRgbEntries colour images (the dataset
+/// reader's association, depth within kMaxDtS). Loaded once per test binary.
 const std::vector<RgbdFrame>& teddyFrames() {
   static const std::vector<RgbdFrame> frames = [] {
-    const auto dir = teddyDir();
-    const auto rgb = test::readTumList((dir / "rgb.txt").string());
-    std::map<double, std::string> depth;
-    for (const auto& e : test::readTumList((dir / "depth.txt").string())) {
-      depth[e.timestamp_s] = e.path;
-    }
+    DatasetOptions options;
+    options.max_time_diff_s = kMaxDtS;
+    options.keep_unassociated_rgb = true;  // one entry per colour image, depth_path "" if none
+    const TumSequence seq = TumSequence::open(teddyDir().string(), options);
     std::vector<RgbdFrame> out;
-    for (std::size_t k = 0; k < std::min(rgb.size(), kRgbEntries); ++k) {
-      const auto& e = rgb[k];
-      const std::string* depth_path = test::nearest(depth, e.timestamp_s, kMaxDtS);
-      if (!depth_path) continue;
-      RgbdFrame f;
-      f.index = out.size();
-      f.timestamp_s = e.timestamp_s;
-      f.bgr = cv::imread((dir / e.path).string(), cv::IMREAD_COLOR);
-      const cv::Mat raw = cv::imread((dir / *depth_path).string(), cv::IMREAD_UNCHANGED);
-      if (f.bgr.empty() || raw.empty()) continue;
-      raw.convertTo(f.depth_m, CV_32F, 1.0 / 5000.0);
-      out.push_back(std::move(f));
+    for (std::size_t k = 0; k < std::min(seq.size(), kRgbEntries); ++k) {
+      if (seq.entries()[k].depth_path.empty()) continue;
+      FrameLoad load = seq.load(k);
+      if (!load.ok) continue;
+      load.frame.index = out.size();
+      out.push_back(std::move(load.frame));
     }
     return out;
   }();
@@ -66,10 +57,11 @@ struct TeddyRun {
 };
 
 /// Tracks every frame (colour of frames in [blank_first, blank_first + blank_count) blacked out)
-/// and aligns the final trajectory to the ground truth (Horn, no scale).
+/// and computes the ATE of the final trajectory (evaluate_ate.py: association within kMaxDtS,
+/// Horn alignment without scale).
 TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
   const auto& frames = teddyFrames();
-  const auto gt = test::readTumGroundTruth((teddyDir() / "groundtruth.txt").string());
+  const std::vector<TimedPose> gt = readTrajectory((teddyDir() / "groundtruth.txt").string());
   Tracker tracker(cameraPreset("freiburg3"), TrackerConfig{}, timings);
   TeddyRun run;
   for (const auto& f : frames) {
@@ -87,16 +79,13 @@ TeddyRun runTeddy(TimingRecorder* timings, int blank_first, int blank_count) {
   tracker.finish();
   run.statuses = tracker.frameStatuses();
   run.stats = tracker.stats();
-  const auto traj = tracker.finalTrajectory();
-  std::vector<Eigen::Vector3d> est, ref;
-  for (const auto& [t, T_W_C] : traj) {
-    const Eigen::Isometry3d* truth = test::nearest(gt, t, kMaxDtS);
-    if (!truth) continue;
-    est.push_back(T_W_C.translation());
-    ref.push_back(truth->translation());
-  }
-  run.gt_matched = est.size();
-  run.ate_m = test::ateRmseAligned(est, ref);
+  std::vector<TimedPose> est;
+  for (const auto& [t, T_W_C] : tracker.finalTrajectory()) est.push_back({t, T_W_C});
+  TrajectoryEvalOptions options;
+  options.max_time_diff_s = kMaxDtS;
+  const AteResult ate = computeAte(gt, est, options);
+  run.gt_matched = ate.pairs;
+  run.ate_m = ate.error_m.rmse;
   return run;
 }
 

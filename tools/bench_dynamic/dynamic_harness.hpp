@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,32 +17,34 @@
 
 #include "dynamap/core/frame.hpp"
 #include "dynamap/core/motion_filter.hpp"
+#include "mask_eval.hpp"
+#include "trajectory_io.hpp"
+#include "tum_dataset.hpp"
 
 namespace dynamap::dynbench {
 
-struct StampedFile {
-  double stamp = 0.0;
-  std::string file;
+/// A TUM image list (rgb.txt, depth.txt, mask.txt) read by tools/io's readListFile.
+struct StampedFiles {
+  std::vector<double> stamps;
+  std::vector<std::string> files;  ///< relative to the sequence folder
 };
 
-inline std::vector<StampedFile> readList(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path.string());
-  std::vector<StampedFile> out;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ss(line);
-    StampedFile f;
-    if (ss >> f.stamp >> f.file) out.push_back(f);
+inline StampedFiles readStampedFiles(const std::filesystem::path& path) {
+  StampedFiles out;
+  for (const ListLine& line : readListFile(path.string())) {
+    if (line.fields.size() < 2) continue;
+    out.stamps.push_back(
+        parseNumberField(line.fields[0], path.string(), line.line_number, "timestamp"));
+    out.files.push_back(line.fields[1]);
   }
   return out;
 }
 
-inline const StampedFile& nearest(const std::vector<StampedFile>& list, double stamp) {
-  return *std::min_element(list.begin(), list.end(), [&](const auto& a, const auto& b) {
-    return std::abs(a.stamp - stamp) < std::abs(b.stamp - stamp);
-  });
+/// Index of the stamp in `stamps` nearest to `stamp` (the first of equally near ones).
+inline std::size_t nearestIndex(const std::vector<double>& stamps, double stamp) {
+  const auto closer = [&](double a, double b) { return std::abs(a - stamp) < std::abs(b - stamp); };
+  return static_cast<std::size_t>(std::min_element(stamps.begin(), stamps.end(), closer) -
+                                  stamps.begin());
 }
 
 struct SequenceFrame {
@@ -54,70 +54,55 @@ struct SequenceFrame {
   cv::Mat teddy_mask;  ///< 255 = teddy (and the top of its box)
 };
 
-/// teddy_dyn_dev: rgb/depth/mask lists (depth and mask associated by nearest stamp), the
-/// ground-truth poses, and the teddy as a world-frame ball (centre measured from frame 0:
-/// median of the near pixels on the teddy back-projected with the ground-truth pose).
+/// teddy_dyn_dev: rgb/depth/mask lists (depth and mask associated by nearest stamp, with no
+/// window: 7 colour images have no depth within 0.02 s), the ground-truth poses (readTrajectory),
+/// and the teddy as a world-frame ball (centre measured from frame 0: median of the near pixels
+/// on the teddy back-projected with the ground-truth pose).
 class DynSequence {
  public:
   explicit DynSequence(const std::filesystem::path& dir)
       : dir_(dir),
-        rgb_(readList(dir / "rgb.txt")),
-        depth_(readList(dir / "depth.txt")),
-        mask_(readList(dir / "mask.txt")),
-        gt_(readList(dir / "groundtruth.txt")) {
-    std::ifstream in(dir / "groundtruth.txt");
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      std::istringstream ss(line);
-      std::vector<double> v(8);
-      for (auto& x : v) ss >> x;
-      poses_.push_back(v);
-    }
+        rgb_(readStampedFiles(dir / "rgb.txt")),
+        depth_(readStampedFiles(dir / "depth.txt")),
+        mask_(readStampedFiles(dir / "mask.txt")),
+        poses_(readTrajectory((dir / "groundtruth.txt").string())) {
+    for (const TimedPose& p : poses_) pose_stamps_.push_back(p.timestamp_s);
   }
-  std::size_t size() const { return rgb_.size(); }
+  std::size_t size() const { return rgb_.stamps.size(); }
 
   SequenceFrame load(std::size_t i) const {
     SequenceFrame f;
+    const double stamp = rgb_.stamps[i];
     f.frame.index = i;
-    f.frame.timestamp_s = rgb_[i].stamp;
-    f.frame.bgr = cv::imread((dir_ / rgb_[i].file).string(), cv::IMREAD_COLOR);
-    const cv::Mat d16 =
-        cv::imread((dir_ / nearest(depth_, rgb_[i].stamp).file).string(), cv::IMREAD_UNCHANGED);
+    f.frame.timestamp_s = stamp;
+    f.frame.bgr = cv::imread((dir_ / rgb_.files[i]).string(), cv::IMREAD_COLOR);
+    const std::string& depth_file = depth_.files[nearestIndex(depth_.stamps, stamp)];
+    const cv::Mat d16 = cv::imread((dir_ / depth_file).string(), cv::IMREAD_UNCHANGED);
     d16.convertTo(f.frame.depth_m, CV_32F, 1.0 / 5000.0);
-    f.gt_mask =
-        cv::imread((dir_ / nearest(mask_, rgb_[i].stamp).file).string(), cv::IMREAD_GRAYSCALE);
+    const std::string& mask_file = mask_.files[nearestIndex(mask_.stamps, stamp)];
+    f.gt_mask = cv::imread((dir_ / mask_file).string(), cv::IMREAD_GRAYSCALE);
     if (f.frame.bgr.empty() || d16.empty() || f.gt_mask.empty()) {
       throw std::runtime_error("cannot read frame " + std::to_string(i) + " of " + dir_.string());
     }
     cv::cvtColor(f.frame.bgr, f.gray, cv::COLOR_BGR2GRAY);
-    f.teddy_mask = teddyMask(f.frame.depth_m, rgb_[i].stamp, f.gt_mask);
+    f.teddy_mask = teddyMask(f.frame.depth_m, stamp, f.gt_mask);
     return f;
   }
 
   /// Ground-truth camera-to-world pose nearest to `stamp` (false if none within 0.02 s).
   bool gtPose(double stamp, Eigen::Isometry3d* T_W_C) const {
     if (poses_.empty()) return false;
-    const auto& p =
-        *std::min_element(poses_.begin(), poses_.end(), [&](const auto& a, const auto& b) {
-          return std::abs(a[0] - stamp) < std::abs(b[0] - stamp);
-        });
-    if (std::abs(p[0] - stamp) > 0.02) return false;
-    T_W_C->setIdentity();
-    T_W_C->linear() = Eigen::Quaterniond(p[7], p[4], p[5], p[6]).normalized().toRotationMatrix();
-    T_W_C->translation() = Eigen::Vector3d(p[1], p[2], p[3]);
+    const TimedPose& p = poses_[nearestIndex(pose_stamps_, stamp)];
+    if (std::abs(p.timestamp_s - stamp) > 0.02) return false;
+    *T_W_C = p.T_W_C;
     return true;
   }
 
  private:
   cv::Mat teddyMask(const cv::Mat& depth, double stamp, const cv::Mat& gt) const {
-    const auto& p =
-        *std::min_element(poses_.begin(), poses_.end(), [&](const auto& a, const auto& b) {
-          return std::abs(a[0] - stamp) < std::abs(b[0] - stamp);
-        });
-    const Eigen::Quaterniond q(p[7], p[4], p[5], p[6]);
-    const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
-    const Eigen::Vector3d t(p[1], p[2], p[3]), centre(-1.7037, 0.0019, 1.2005);
+    const Eigen::Isometry3d& T_W_C = poses_[nearestIndex(pose_stamps_, stamp)].T_W_C;
+    const Eigen::Matrix3d R = T_W_C.linear();
+    const Eigen::Vector3d t = T_W_C.translation(), centre(-1.7037, 0.0019, 1.2005);
     cv::Mat out = cv::Mat::zeros(depth.size(), CV_8UC1);
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {
@@ -131,8 +116,9 @@ class DynSequence {
   }
 
   std::filesystem::path dir_;
-  std::vector<StampedFile> rgb_, depth_, mask_, gt_;
-  std::vector<std::vector<double>> poses_;
+  StampedFiles rgb_, depth_, mask_;
+  std::vector<TimedPose> poses_;
+  std::vector<double> pose_stamps_;
 };
 
 /// Good features in the previous frame tracked by pyramidal LK (6 levels) with a
@@ -167,25 +153,20 @@ struct MaskScore {
   long standing_px = 0, standing_masked_px = 0, teddy_px = 0, teddy_masked_px = 0;
 };
 
+/// tools/eval's scoreMask (any non-zero pixel of `mask_in` counts as masked) plus the teddy.
 inline MaskScore scoreMask(const cv::Mat& mask_in, const cv::Mat& gt, const cv::Mat& teddy) {
   const cv::Mat mask = mask_in.empty() ? cv::Mat::zeros(gt.size(), CV_8UC1) : (mask_in > 0);
-  const cv::Mat moving = gt == 255, standing = gt == 128;
+  const MaskFrameScore f = dynamap::scoreMask(mask, gt);
   MaskScore s;
-  const int n_moving = cv::countNonZero(moving);
-  s.moving_visible = n_moving > 0;
-  const int inter = cv::countNonZero(mask & moving);
-  const int uni = cv::countNonZero(mask | moving);
-  s.iou = uni > 0 ? double(inter) / uni : 0.0;
-  const int n_standing = cv::countNonZero(standing);
-  s.standing_masked =
-      n_standing > 0 ? double(cv::countNonZero(mask & standing)) / n_standing : -1.0;
-  const int n_teddy = cv::countNonZero(teddy);
-  s.teddy_masked = n_teddy > 0 ? double(cv::countNonZero(mask & teddy)) / n_teddy : -1.0;
-  s.masked_share = double(cv::countNonZero(mask)) / double(mask.total());
-  s.standing_px = n_standing;
-  s.standing_masked_px = cv::countNonZero(mask & standing);
-  s.teddy_px = n_teddy;
+  s.moving_visible = f.gt_moving > 0;
+  s.iou = f.gt_moving + f.est_dynamic > 0 ? f.iou() : 0.0;
+  s.standing_px = static_cast<long>(f.gt_standing);
+  s.standing_masked_px = static_cast<long>(f.standing_masked);
+  s.standing_masked = f.gt_standing > 0 ? double(f.standing_masked) / double(f.gt_standing) : -1.0;
+  s.teddy_px = cv::countNonZero(teddy);
   s.teddy_masked_px = cv::countNonZero(mask & teddy);
+  s.teddy_masked = s.teddy_px > 0 ? double(s.teddy_masked_px) / double(s.teddy_px) : -1.0;
+  s.masked_share = double(f.est_dynamic) / double(mask.total());
   return s;
 }
 

@@ -12,6 +12,7 @@
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "dynamic_harness.hpp"
+#include "trajectory_eval.hpp"
 
 namespace dynamap::dynbench {
 
@@ -77,7 +78,8 @@ struct TrackedFrame {
   Eigen::Isometry3d T_gt = Eigen::Isometry3d::Identity();
 };
 
-/// RMSE of positions after a rigid (Horn/Umeyama, no scale) alignment of est onto ref.
+/// ATE RMSE (tools/eval computeAteOfPairs: Horn alignment without scale) of position pairs
+/// already associated; 1e9 when fewer than 3 pairs or the lists differ in length.
 inline double ateRmse(const std::vector<Eigen::Vector3d>& est,
                       const std::vector<Eigen::Vector3d>& ref) {
   const auto n = static_cast<Eigen::Index>(est.size());
@@ -87,10 +89,7 @@ inline double ateRmse(const std::vector<Eigen::Vector3d>& est,
     a.col(i) = est[static_cast<std::size_t>(i)];
     b.col(i) = ref[static_cast<std::size_t>(i)];
   }
-  const Eigen::Matrix4d T = Eigen::umeyama(a, b, false);
-  const Eigen::Matrix3Xd aligned =
-      (T.topLeftCorner<3, 3>() * a).colwise() + T.topRightCorner<3, 1>();
-  return std::sqrt((aligned - b).colwise().squaredNorm().mean());
+  return computeAteOfPairs(a, b, /*with_scale=*/false).error_m.rmse;
 }
 
 }  // namespace dynamap::dynbench

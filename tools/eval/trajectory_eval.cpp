@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <utility>
 
 #include <Eigen/SVD>
 
@@ -163,6 +164,22 @@ Alignment alignPoses(const std::vector<TimedPose>& gt_in, const std::vector<Time
   return a;
 }
 
+AteResult computeAteOfPairs(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt,
+                            bool with_scale) {
+  AteResult r;
+  r.with_scale = with_scale;
+  r.alignment = alignPositions(est, gt, with_scale);
+  r.pairs = static_cast<std::size_t>(est.cols());
+  for (Eigen::Index k = 0; k < est.cols(); ++k) {
+    const Eigen::Vector3d aligned = r.alignment.scale * r.alignment.R * est.col(k) + r.alignment.t;
+    r.gt_positions_m.push_back(gt.col(k));
+    r.est_aligned_m.push_back(aligned);
+    r.errors_m.push_back((aligned - gt.col(k)).norm());
+  }
+  r.error_m = computeErrorStats(r.errors_m);
+  return r;
+}
+
 AteResult computeAte(const std::vector<TimedPose>& gt_in, const std::vector<TimedPose>& est_in,
                      const TrajectoryEvalOptions& options) {
   const std::vector<TimedPose> gt = asTimeDict(gt_in);
@@ -179,24 +196,15 @@ AteResult computeAte(const std::vector<TimedPose>& gt_in, const std::vector<Time
   const auto n = static_cast<Eigen::Index>(matches.size());
   Eigen::Matrix3Xd est_xyz(3, n);
   Eigen::Matrix3Xd gt_xyz(3, n);
-  AteResult r;
+  std::vector<double> timestamps_s;
   for (Eigen::Index k = 0; k < n; ++k) {
     const auto& [i_gt, i_est] = matches[static_cast<std::size_t>(k)];
     gt_xyz.col(k) = gt[i_gt].T_W_C.translation();
     est_xyz.col(k) = est[i_est].T_W_C.translation();
-    r.timestamps_s.push_back(gt[i_gt].timestamp_s);
+    timestamps_s.push_back(gt[i_gt].timestamp_s);
   }
-  r.with_scale = options.alignment == AlignmentKind::kSim3;
-  r.alignment = alignPositions(est_xyz, gt_xyz, r.with_scale);
-  r.pairs = matches.size();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::Vector3d aligned =
-        r.alignment.scale * r.alignment.R * est_xyz.col(k) + r.alignment.t;
-    r.gt_positions_m.push_back(gt_xyz.col(k));
-    r.est_aligned_m.push_back(aligned);
-    r.errors_m.push_back((aligned - gt_xyz.col(k)).norm());
-  }
-  r.error_m = computeErrorStats(r.errors_m);
+  AteResult r = computeAteOfPairs(est_xyz, gt_xyz, options.alignment == AlignmentKind::kSim3);
+  r.timestamps_s = std::move(timestamps_s);
   return r;
 }
 

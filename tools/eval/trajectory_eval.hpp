@@ -94,6 +94,12 @@ struct TrajectoryEvaluation {
 Alignment alignPoses(const std::vector<TimedPose>& gt, const std::vector<TimedPose>& est,
                      double max_time_diff_s, double rotation_weight_m2 = 1.0);
 
+/// ATE of position pairs already associated (column k of `est` with column k of `gt`, N >= 1):
+/// alignment, per-pair errors and their statistics; `timestamps_s` stays empty. computeAte is
+/// this after associating by time.
+AteResult computeAteOfPairs(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt,
+                            bool with_scale);
+
 /// ATE as evaluate_ate.py. Throws EvaluationError when fewer than 2 pairs associate.
 AteResult computeAte(const std::vector<TimedPose>& gt, const std::vector<TimedPose>& est,
                      const TrajectoryEvalOptions& options);
