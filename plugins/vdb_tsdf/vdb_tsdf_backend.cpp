@@ -1,18 +1,13 @@
 // `vdb_tsdf`: OpenVDB colour TSDF with projective integration and space carving
 // (tsdf_volume.hpp). Exports mesh.ply, mesh.obj and tsdf.vdb. Pose updates: the mapping worker
 // rebuilds the volume with the final poses (PoseUpdateMode::kReintegrate).
-#include <charconv>
-#include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <thread>
-#include <vector>
-
-#include <tbb/parallel_for.h>
 
 #include "dynamap/mapping/backend_params.hpp"
+#include "dynamap/mapping/obj_io.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
 #include "tsdf_volume.hpp"
 
@@ -41,76 +36,7 @@ plugin::TsdfOptions readOptions(const BackendParams& params) {
   return o;
 }
 
-/// Appends `value` as printf's "%.<precision>f" writes it (std::to_chars promises the same
-/// characters, without printf's format parsing: the OBJ is written ~4 x faster).
-void appendFixed(std::string& out, double value, int precision) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::fixed, precision);
-  if (r.ec == std::errc()) {
-    out.append(buf, r.ptr);
-  } else {  // |value| of 1e50 and more: not a map coordinate, but written as printf would
-    char big[400];
-    std::snprintf(big, sizeof(big), "%.*f", precision, value);
-    out += big;
-  }
-}
-
-void appendIndex(std::string& out, std::uint32_t index) {
-  char buf[16];
-  const auto r = std::to_chars(buf, buf + sizeof(buf), index);
-  out.append(buf, r.ptr);
-}
-
-/// The OBJ text of vertices [begin, end) or, with faces, of triangles [begin, end).
-std::string objLines(const PlyData& mesh, bool faces, std::size_t begin, std::size_t end) {
-  std::string text;
-  text.reserve((end - begin) * (faces ? 24 : 56));
-  for (std::size_t i = begin; i < end; ++i) {
-    if (faces) {
-      text += 'f';
-      for (const std::uint32_t index : mesh.triangles[i]) {
-        text += ' ';
-        appendIndex(text, index + 1);
-      }
-    } else {
-      const auto& p = mesh.vertices[i];
-      const auto& c = mesh.colors[i];
-      text += 'v';
-      for (int a = 0; a < 3; ++a) {
-        text += ' ';
-        appendFixed(text, p[a], 5);
-      }
-      for (int a = 0; a < 3; ++a) {
-        text += ' ';
-        appendFixed(text, c[static_cast<std::size_t>(a)] / 255.0, 4);
-      }
-    }
-    text += '\n';
-  }
-  return text;
-}
-
-/// Writes the mesh as OBJ text. Its pieces (64k lines each) are formatted on every core, then
-/// written in order: the same bytes as one pass, in about half the time.
-void writeObj(const std::string& path, const PlyData& mesh) {
-  constexpr std::size_t kLines = 1 << 16;
-  const std::size_t nv = mesh.vertices.size(), nf = mesh.triangles.size();
-  const std::size_t vertex_pieces = (nv + kLines - 1) / kLines;
-  std::vector<std::string> pieces(vertex_pieces + (nf + kLines - 1) / kLines);
-  tbb::parallel_for(std::size_t{0}, pieces.size(), [&](std::size_t k) {
-    const bool faces = k >= vertex_pieces;
-    const std::size_t begin = (faces ? k - vertex_pieces : k) * kLines;
-    pieces[k] = objLines(mesh, faces, begin, std::min(faces ? nf : nv, begin + kLines));
-  });
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) throw MappingError(path + ": cannot write OBJ file");
-  const std::string header = "# dynamap vdb_tsdf mesh: v x y z r g b (colour in [0, 1])\n";
-  bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size();
-  for (const std::string& piece : pieces)
-    ok = ok && std::fwrite(piece.data(), 1, piece.size(), f) == piece.size();
-  ok = ok && std::ferror(f) == 0;
-  if (std::fclose(f) != 0 || !ok) throw MappingError(path + ": write failed");
-}
+const ObjFormat kObjFormat{"dynamap vdb_tsdf mesh: v x y z r g b (colour in [0, 1])", 5};
 
 class VdbTsdfBackend final : public MapBackend {
  public:
@@ -157,7 +83,7 @@ class VdbTsdfBackend final : public MapBackend {
       mesh = volume_.extractMesh(*voted);
       obj = on_thread(obj_error, [&] {
         writeAtomically((d / "mesh.obj").string(),
-                        [&](const std::string& tmp) { writeObj(tmp, mesh); });
+                        [&](const std::string& tmp) { writeObj(tmp, mesh, kObjFormat); });
       });
       writeAtomically((d / "mesh.ply").string(),
                       [&](const std::string& tmp) { writePly(tmp, mesh); });

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "dynamap/mapping/obj_io.hpp"
 #include "dynamap/mapping/ply_io.hpp"
 
 namespace dynamap {
@@ -94,26 +95,6 @@ void writeXyz(const std::string& path, const PlyData& map) {
   out.close();
 }
 
-void writeObj(const std::string& path, const PlyData& map) {
-  const bool rgb = hasColors(map);
-  LineWriter out(path);
-  out.text("# written by dynamap export\n");
-  for (std::size_t i = 0; i < map.vertices.size(); ++i) {
-    const Eigen::Vector3f& p = map.vertices[i];
-    if (rgb) {
-      const auto& c = map.colors[i];
-      out.line("v %.6f %.6f %.6f %.4f %.4f %.4f\n", p.x(), p.y(), p.z(), c[0] / 255.0, c[1] / 255.0,
-               c[2] / 255.0);
-    } else {
-      out.line("v %.6f %.6f %.6f\n", p.x(), p.y(), p.z());
-    }
-  }
-  for (const auto& t : map.triangles) {
-    out.line("f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
-  }
-  out.close();
-}
-
 }  // namespace
 
 std::string resolveMapFile(const std::string& map) {
@@ -158,7 +139,7 @@ MapExportResult exportMap(const std::string& map, const std::string& to) {
       if (ext == ".ply") writePly(tmp, data);
       if (ext == ".pcd") writePcd(tmp, data);
       if (ext == ".xyz") writeXyz(tmp, data);
-      if (ext == ".obj") writeObj(tmp, data);
+      if (ext == ".obj") writeObj(tmp, data, ObjFormat{"written by dynamap export", 6});
     });
   } catch (const std::exception& e) {
     const std::string what = e.what();
