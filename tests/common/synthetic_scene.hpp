@@ -25,6 +25,17 @@
 
 namespace dynamap::test {
 
+/// A camera pose in the scene: at `t`, turned `yaw_deg` about y (the rooms' down axis), then
+/// `pitch_deg` about x.
+inline Eigen::Isometry3d cameraPose(const Eigen::Vector3d& t, double yaw_deg, double pitch_deg) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(pitch_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
 struct RenderedFrame {
   cv::Mat bgr;      ///< CV_8UC3
   cv::Mat depth_m;  ///< CV_32FC1, 0 = nothing hit

@@ -15,15 +15,6 @@ PinholeCamera testCamera() {
   return camera;
 }
 
-Eigen::Isometry3d poseAt(const Eigen::Vector3d& t, double yaw_deg, double pitch_deg) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(pitch_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = t;
-  return T;
-}
-
 double angleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
 }
@@ -41,8 +32,8 @@ TEST(DepthAlignment, FindsTheMotionInARoomFromTheLastPose) {
   const PinholeCamera camera = testCamera();
   test::SyntheticScene scene(camera, 3);
   scene.addDefaultRoom();
-  const Eigen::Isometry3d T_ref = poseAt({0.0, 0.0, 0.0}, 0.0, 0.0);
-  const Eigen::Isometry3d T_cur = poseAt({0.04, -0.02, 0.05}, 2.5, -1.5);
+  const Eigen::Isometry3d T_ref = test::cameraPose({0.0, 0.0, 0.0}, 0.0, 0.0);
+  const Eigen::Isometry3d T_cur = test::cameraPose({0.04, -0.02, 0.05}, 2.5, -1.5);
   const PosedDepth ref = posed(scene.render(T_ref, 0.0), T_ref, false);
   PosedDepth cur = posed(scene.render(T_cur, 0.0), T_ref, false);  // guess: the last pose
   const DepthAlignment a = alignDepth(ref, cur, camera);
@@ -58,8 +49,8 @@ TEST(DepthAlignment, AMaskedMoverCoveringMuchOfTheViewDoesNotPullThePose) {
   scene.addDefaultRoom();
   // Left of centre: the right static box's side (the view's only x-facing surface) stays seen.
   scene.addMovingBox({-0.5, 0.2, 1.5}, {0.4, 0.8, 0.15}, {0.8, 0.0, 0.0});
-  const Eigen::Isometry3d T_ref = poseAt({0.0, 0.0, 0.0}, 0.0, 0.0);
-  const Eigen::Isometry3d T_cur = poseAt({-0.03, 0.01, 0.03}, -2.0, 1.0);
+  const Eigen::Isometry3d T_ref = test::cameraPose({0.0, 0.0, 0.0}, 0.0, 0.0);
+  const Eigen::Isometry3d T_cur = test::cameraPose({-0.03, 0.01, 0.03}, -2.0, 1.0);
   const test::RenderedFrame f_ref = scene.render(T_ref, 0.0), f_cur = scene.render(T_cur, 0.1);
   ASSERT_GT(cv::countNonZero(f_cur.mask), f_cur.mask.total() / 4);  // the box fills > 25 %
   const DepthAlignment a =
@@ -75,7 +66,7 @@ TEST(DepthAlignment, OnePlaneLeavesTranslationFreeAndIsNotAccepted) {
   test::SyntheticScene scene(camera, 7);
   scene.addPlane({-4.0, -3.0, 2.5}, {8.0, 0, 0}, {0, 6.0, 0});  // a wall filling the view
   const Eigen::Isometry3d T_ref = Eigen::Isometry3d::Identity();
-  const Eigen::Isometry3d T_cur = poseAt({0.05, 0.0, 0.02}, 0.0, 0.0);
+  const Eigen::Isometry3d T_cur = test::cameraPose({0.05, 0.0, 0.02}, 0.0, 0.0);
   const DepthAlignment a = alignDepth(posed(scene.render(T_ref, 0.0), T_ref, false),
                                       posed(scene.render(T_cur, 0.0), T_ref, false), camera);
   EXPECT_FALSE(a.accepted) << "weakest direction " << a.weakest_direction_points;

@@ -17,15 +17,6 @@
 namespace dynamap {
 namespace {
 
-Eigen::Isometry3d poseAt(const Eigen::Vector3d& t, double yaw_deg, double pitch_deg) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(pitch_deg * M_PI / 180.0, Eigen::Vector3d::UnitX()))
-                   .toRotationMatrix();
-  T.translation() = t;
-  return T;
-}
-
 cv::Mat grayOf(const test::RenderedFrame& f) {
   cv::Mat gray;
   cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
@@ -69,8 +60,8 @@ class RelocalizerTest : public ::testing::Test {
         optimizer_(camera_, config_),
         relocalizer_(config_, optimizer_) {
     scene_.addDefaultRoom();
-    addKeyframe(scene_, orb_, config_, poseAt({0.0, 0.0, 0.0}, 0.0, 0.0), 0.0, map_);
-    addKeyframe(scene_, orb_, config_, poseAt({0.15, 0.02, 0.10}, 4.0, -2.0), 0.5, map_);
+    addKeyframe(scene_, orb_, config_, test::cameraPose({0.0, 0.0, 0.0}, 0.0, 0.0), 0.0, map_);
+    addKeyframe(scene_, orb_, config_, test::cameraPose({0.15, 0.02, 0.10}, 4.0, -2.0), 0.5, map_);
   }
 
   RelocalizationResult relocalizeFrame(const test::SyntheticScene& scene,
@@ -91,12 +82,12 @@ class RelocalizerTest : public ::testing::Test {
 };
 
 // Between the two keyframes, 7 cm and 3 degrees from the nearer one.
-const Eigen::Isometry3d kQueryPose = poseAt({0.08, -0.03, 0.06}, 2.5, 1.5);
+const Eigen::Isometry3d kQueryPose = test::cameraPose({0.08, -0.03, 0.06}, 2.5, 1.5);
 
 TEST_F(RelocalizerTest, AFrameFromAKnownPoseIsRelocalizedToItFromAWrongHint) {
   // A hint 1 m and 40 degrees off projects no landmark near its keypoint: the guided search
   // finds nothing and the global descriptor search must do it.
-  const Eigen::Isometry3d wrong_hint = poseAt({-0.9, 0.3, 0.5}, -40.0, 10.0);
+  const Eigen::Isometry3d wrong_hint = test::cameraPose({-0.9, 0.3, 0.5}, -40.0, 10.0);
   const RelocalizationResult r = relocalizeFrame(scene_, kQueryPose, wrong_hint);
   ASSERT_TRUE(r.ok);
   const Errors e = poseError(r.T_W_C, kQueryPose);
@@ -135,7 +126,7 @@ TEST_F(RelocalizerTest, AFrameOfAnotherSceneIsNotRelocalized) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene other(camera, 99);
   other.addDefaultRoom();
-  for (const auto& hint : {kQueryPose, poseAt({-0.9, 0.3, 0.5}, -40.0, 10.0)}) {
+  for (const auto& hint : {kQueryPose, test::cameraPose({-0.9, 0.3, 0.5}, -40.0, 10.0)}) {
     const RelocalizationResult r = relocalizeFrame(other, kQueryPose, hint);
     EXPECT_FALSE(r.ok) << "inliers " << r.inliers;
     EXPECT_TRUE(r.landmark_ids.empty());
