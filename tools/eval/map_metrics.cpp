@@ -4,8 +4,10 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <thread>
 #include <unordered_map>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "dynamap/mapping/ply_io.hpp"
 #include "dynamap/mapping/voxel_key.hpp"
@@ -18,15 +20,13 @@ constexpr double kCoarseDiagonal = 1.7321 * ReferenceClouds::kCoarseVoxelM + 1e-
 
 std::uint64_t packCell(const Eigen::Vector3i& c) { return packVoxelKey(c.x(), c.y(), c.z()); }
 
-// Runs fn(i) for i in [0, n) on two threads (the machines have 2 cores).
+// Runs fn(i) for i in [0, n) with TBB. fn writes only its own index's slot; the sums are taken
+// afterwards in index order, so the results do not depend on the threads.
 template <typename Fn>
 void parallelFor(std::size_t n, const Fn& fn) {
-  const std::size_t half = n / 2;
-  std::thread t([&] {
-    for (std::size_t i = 0; i < half; ++i) fn(i);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) fn(i);
   });
-  for (std::size_t i = half; i < n; ++i) fn(i);
-  t.join();
 }
 
 // Voxel key of a point (21 bits per axis, wrapping); `cell` receives the integer voxel.
