@@ -6,6 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "dynamap/core/rounding.hpp"
+
 namespace dynamap {
 namespace {
 
@@ -81,7 +83,8 @@ Linearisation linearise(const PosedDepth& ref, const std::vector<Eigen::Vector3d
     const Eigen::Vector3d q = T_R_C * p_C;
     if (q.z() <= 0.0) continue;
     const Eigen::Vector2d px = camera.project(q);
-    const int x = static_cast<int>(std::lround(px.x())), y = static_cast<int>(std::lround(px.y()));
+    const int x = static_cast<int>(roundHalfAway(px.x()));
+    const int y = static_cast<int>(roundHalfAway(px.y()));
     if (!surfaceAt(ref, camera, o, x, y, surface)) continue;
     if ((q - surface.point).norm() > gate_m) continue;
     const double e = surface.normal.dot(q - surface.point);
