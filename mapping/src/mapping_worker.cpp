@@ -108,11 +108,19 @@ void MappingWorker::run() {
       }
       updates.swap(pending_updates_);
       if (!kf && updates.empty() && stopping_) break;
+      busy_ = true;
     }
     not_full_.notify_all();
-    std::lock_guard<std::mutex> lock(backend_mutex_);
-    if (kf) advanceWindow(std::move(kf), false);
-    for (const auto& u : updates) applyUpdateLocked(u);
+    {
+      std::lock_guard<std::mutex> lock(backend_mutex_);
+      if (kf) advanceWindow(std::move(kf), false);
+      for (const auto& u : updates) applyUpdateLocked(u);
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    idle_.notify_all();
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   advanceWindow(nullptr, true);
@@ -143,6 +151,7 @@ void MappingWorker::advanceWindow(KeyframePacketPtr kf, bool flush) {
     integratePacket(*window_[i].kf, flagged);
     window_[i].integrated = true;
   }
+  if (!deferred()) judgeReadyLocked(false);
   // Keep the n integrated keyframes before the first waiting one.
   std::size_t integrated = 0;
   while (integrated < window_.size() && window_[integrated].integrated) ++integrated;
@@ -159,11 +168,13 @@ void MappingWorker::applyUpdateLocked(const PoseUpdate& update) {
     return;
   }
   it->second.T_current = update.T_W_C;
-  if (!deferred()) backend_->updatePose(update.keyframe_id, update.T_W_C);
+  if (it->second.integrated) backend_->updatePose(update.keyframe_id, update.T_W_C);
+  if (it->second.supplemented)
+    backend_->updatePose(update.keyframe_id | kSupplementBit, update.T_W_C);
 }
 
 void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask) {
-  ScopedStageTimer timer(timings_, deferred() ? "mapping_keyframe" : "mapping_integrate");
+  ScopedStageTimer timer(timings_, "mapping_keyframe");
   cv::Mat mask = kf.dynamic_mask;
   if (!extra_mask.empty() && cv::countNonZero(extra_mask) > 0) {
     mask = mask.empty() ? extra_mask : cv::max(mask, extra_mask);
@@ -172,23 +183,8 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   rec.timestamp_s = kf.timestamp_s;
   rec.T_integrated = kf.T_W_C;
   rec.T_current = kf.T_W_C;
-  cv::Mat static_depth_m;
-  if (deferred()) {
-    static_depth_m = staticDepth(kf.depth_m, mask, options_);
-  } else {
-    StaticPoints sp;
-    sp.static_depth_m = staticDepth(kf.depth_m, mask, options_);
-    if (backend_->needsPoints()) {
-      backProjectDepth(camera_, kf.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                       &sp.colors);
-    }
-    backend_->integrate(keyframeView(kf.id, kf.timestamp_s, kf.T_W_C, camera_, kf.bgr, sp));
-    static_depth_m = sp.static_depth_m;
-  }
-  if (backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate || options_.visibility.enabled) {
-    static_depth_m.convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
-    rec.bgr = kf.bgr;  // shared, immutable packet data
-  }
+  staticDepth(kf.depth_m, mask, options_).convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
+  rec.bgr = kf.bgr;  // shared, immutable packet data
   if (options_.visibility.enabled)
     rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
   if (options_.held_revision_voxel_m > 0.0) {
@@ -206,7 +202,10 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
       rec.extra_mask = extra_mask;
     }
   }
-  if (records_.emplace(kf.id, std::move(rec)).second) order_.push_back(kf.id);
+  if (records_.emplace(kf.id, std::move(rec)).second) {
+    order_.push_back(kf.id);
+    if (!deferred()) judge_.push_back(kf.id);
+  }
   const auto early = early_updates_.find(kf.id);
   if (early != early_updates_.end()) {
     const PoseUpdate update{kf.id, early->second};
@@ -231,14 +230,7 @@ bool MappingWorker::removeSeenThroughLocked() {
     keyframes.push_back(k);
   }
   visibility_ = removeSeenThrough(camera_, keyframes, options_.visibility);
-  if (timings_ != nullptr) {
-    for (const double ms : visibility_.per_keyframe_ms) timings_->add("mapping_visibility_kf", ms);
-    timings_->add("mapping_visibility_key", visibility_.key_ms);
-    timings_->add("mapping_visibility_add", visibility_.add_ms);
-    timings_->add("mapping_visibility_project", visibility_.project_ms);
-    timings_->add("mapping_visibility_verdict", visibility_.verdict_ms);
-    timings_->add("mapping_visibility_zero", visibility_.zero_ms);
-  }
+  addVisibilityTimings(visibility_);
   return visibility_.removed_pixels > 0;
 }
 
@@ -258,26 +250,12 @@ bool MappingWorker::reviseHeldLocked() {
   std::vector<cv::Mat> revised(order_.size());
   inTwo([&](int h) {  // every other keyframe: each thread writes only its keyframes' records
     for (std::size_t i = static_cast<std::size_t>(h); i < order_.size(); i += 2) {
-      KeyframeRecord& rec = records_.at(order_[i]);
-      if (!hits[i].empty() && !rec.depth_u16.empty()) {
-        revised[i] = rec.dynamic_mask.clone();
-        revised[i].setTo(0, hits[i]);
-        const cv::Mat map_mask =
-            rec.extra_mask.empty() ? revised[i] : cv::max(revised[i], rec.extra_mask);
-        staticDepth(keyframes[i].depth_m, map_mask, options_)
-            .convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
-      }
-      rec.held = HeldKeyframe();  // done: its depth and masks are released
-      rec.dynamic_mask.release();
-      rec.extra_mask.release();
+      revised[i] = reviseOneLocked(order_[i], hits[i], keyframes[i].depth_m, false);
     }
   });
   bool any = false;
   for (std::size_t i = 0; i < order_.size(); ++i) {
     if (revised[i].empty()) continue;
-    // The visibility pass's mask votes keep reading the masks as they were: a person the
-    // revision wrongly unmasked (a swayer confirmed static now and then) is still voted out of
-    // the map by the views that masked him.
     revised_masks_[order_[i]] = revised[i];
     any = true;
   }
@@ -328,6 +306,7 @@ void MappingWorker::rebuildIfNeeded(bool force) {
     if (deferred()) timer.emplace(timings_, "mapping_integrate");
     backend_->integrate(keyframeView(id, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
     rec.T_integrated = rec.T_current;
+    rec.integrated = true;
   };
   StaticPoints sp[2];
   if (!order_.empty()) prepare(order_.front(), sp[0]);
@@ -357,7 +336,11 @@ void MappingWorker::drain() {
   std::lock_guard<std::mutex> lock(backend_mutex_);
   if (drained_) return;
   drained_ = true;
-  prepareHeldLocked();
+  if (deferred()) {
+    prepareHeldLocked();
+  } else {
+    judgeReadyLocked(true);  // the last keyframes, with the poses before the final ones
+  }
 }
 
 void MappingWorker::finish() {
@@ -374,9 +357,18 @@ void MappingWorker::finish() {
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   for (const auto& u : late) applyUpdateLocked(u);
-  const bool revised = reviseHeldLocked();
-  const bool removed = removeSeenThroughLocked();
-  rebuildIfNeeded(removed || revised || deferred());
+  if (!deferred()) {
+    rebuildIfNeeded(false);  // a volumetric backend whose keyframes moved
+    return;
+  }
+  reviseHeldLocked();
+  removeSeenThroughLocked();
+  rebuildIfNeeded(true);
+}
+
+void MappingWorker::waitIdle() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return (queue_.empty() && !busy_) || stopping_; });
 }
 
 void MappingWorker::exportMap(const std::string& dir) {

@@ -135,6 +135,11 @@ PYBIND11_MODULE(dynamap, m) {
       .def("export_map", &System::exportMap, py::arg("directory"),
            py::call_guard<py::gil_scoped_release>(),
            "export_map(directory): finish(), then writes the backend's map files there.")
+      .def("export_map_snapshot", &System::exportMapSnapshot, py::arg("directory"),
+           py::call_guard<py::gil_scoped_release>(),
+           "export_map_snapshot(directory): the map as it is now, during the run, without "
+           "finishing (the keyframes of the last mapping.window_after_s are not in it yet); "
+           "writes the backend's map files there. After finish(): the final map.")
       .def_property_readonly(
           "counts",
           [](const System& s) {
@@ -146,6 +151,7 @@ PYBIND11_MODULE(dynamap, m) {
             d["lost"] = c.lost;
             d["keyframes"] = c.keyframes;
             d["mapped_keyframes"] = c.mapped_keyframes;
+            d["map_elements"] = c.map_elements;
             return d;
           },
           "Frame and keyframe counts so far (dict).");

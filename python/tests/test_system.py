@@ -116,3 +116,29 @@ def test_track_after_finish_raises():
 def test_docstrings():
     assert "BGR" in dynamap.System.track.__doc__
     assert "ConfigError" in dynamap.System.__init__.__doc__
+
+
+def ply_vertices(path):
+    """The vertex count in a PLY header."""
+    with open(path, "rb") as f:
+        for line in f:
+            if line.startswith(b"element vertex"):
+                return int(line.split()[2])
+            if line.strip() == b"end_header":
+                break
+    return 0
+
+
+def test_map_snapshot_before_finish(teddy, tmp_path):
+    """The map exists while the camera runs: a snapshot mid-run holds keyframes and points."""
+    system = dynamap.System(overrides=FAST)
+    frames = tum_frames(teddy)[:60]
+    for t, bgr, depth in map(load, frames):
+        system.track(bgr, depth, t)
+    system.export_map_snapshot(str(tmp_path / "mid"))
+    mid_keyframes = system.counts["mapped_keyframes"]
+    mid_points = ply_vertices(tmp_path / "mid" / "cloud.ply")
+    assert mid_keyframes > 0 and mid_points > 0
+    assert system.counts["map_elements"] == mid_points
+    system.finish()
+    assert system.counts["mapped_keyframes"] >= mid_keyframes

@@ -34,7 +34,10 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addInt("mapping.visibility_mask_near_px", &vis.mask_near_px, 0, 1000);
   schema.addDouble("mapping.visibility_mask_near_depth_m", &vis.mask_near_depth_m, 0.0, 100.0);
   schema.addInt("mapping.visibility_mask_grow_px", &vis.mask_grow_px, 0, 100);
-  schema.addBool("mapping.deferred_integration", &s.deferred_integration);
+  schema.addDouble("mapping.window_before_s", &s.window_before_s, 0.0, 1e6);
+  schema.addDouble("mapping.window_after_s", &s.window_after_s, 0.0, 1e6);
+  schema.addDouble("mapping.held_window_after_s", &s.held_window_after_s, 0.0, 1e6);
+  schema.addBool("mapping.visibility_final_pass", &s.visibility_final_pass);
   schema.addDouble("mapping.held_revision_voxel_m", &s.held_revision_voxel_m, 0.0, 1.0);
   schema.addInt("mapping.held_revision_min_keyframes", &s.held_revision_min_keyframes, 1, 1000);
 }

@@ -250,7 +250,9 @@ SystemCounts System::counts() const {
   } else {
     c.tracked = s.given_trajectory.size();
   }
-  c.mapped_keyframes = s.mapper->stats().keyframes;
+  const MapStats map = s.mapper->stats();
+  c.mapped_keyframes = map.keyframes;
+  c.map_elements = map.elements;
   return c;
 }
 
@@ -300,6 +302,13 @@ void System::exportMap(const std::string& dir) {
   finish();
   std::filesystem::create_directories(dir);
   ScopedStageTimer timer(impl_->timings, "map_export");
+  impl_->mapper->exportMap(dir);
+}
+
+void System::exportMapSnapshot(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  impl_->mapper->waitIdle();
+  ScopedStageTimer timer(impl_->timings, "map_snapshot");
   impl_->mapper->exportMap(dir);
 }
 

@@ -82,8 +82,8 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   FakeLog log;
   TimingRecorder timings;
   StaticPointsOptions options = countingOptions();
-  options.free_space.enabled = false;    // integrate on arrival (no neighbour window)
-  options.deferred_integration = false;  // ... as each keyframe arrives
+  options.free_space.enabled = false;  // integrate on arrival (no neighbour window)
+  options.window_after_s = 0.0;        // ... nor judgement window
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
                        SyntheticScene::camera(), options, 1, &timings);
   worker.push(packet(1));  // taken by the worker thread, which blocks in integrate()
@@ -198,16 +198,15 @@ TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
   for (const double dx : {0.001, 0.05}) {
     FakeLog log;
     log.released = true;
-    StaticPointsOptions options = countingOptions();
-    options.deferred_integration = false;
     MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
-                         SyntheticScene::camera(), options, 4, nullptr);
+                         SyntheticScene::camera(), countingOptions(), 4, nullptr);
     std::vector<PoseUpdate> updates;
     for (std::uint64_t id = 0; id < 3; ++id) {
       const auto kf = packet(id);
       worker.push(kf);
       updates.push_back({id, Eigen::Translation3d(dx, 0, 0) * kf->T_W_C});
     }
+    worker.drain();  // integrated (as System::finish(): then the final poses come)
     worker.applyPoseUpdates(updates);
     worker.finish();
     const bool rebuilt = dx > MappingWorker::kReintegrateTranslationM;
@@ -221,17 +220,19 @@ TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
   }
 }
 
-// Deferred integration (the default with the visibility pass on): the backend gets each keyframe
-// exactly once, in finish(), with its final pose, and never a reset; with it off, the same pose
-// updates cost a second integration of every keyframe after a reset.
-TEST(MappingWorker, DeferredIntegrationIntegratesEachKeyframeOnceWithItsFinalPose) {
-  std::vector<std::size_t> points[2];  // [live, deferred]: points per keyframe
-  for (const bool deferred : {true, false}) {
+// The final pass (mapping.visibility_final_pass, the offline extra): the backend gets each
+// keyframe exactly once, in finish(), with its final pose, and never a reset. Online (the
+// default) each keyframe is integrated when judged, here in drain(); the final poses then cost
+// a volumetric backend a second integration of every keyframe after a reset. The points are the
+// same either way (from the stored static depth).
+TEST(MappingWorker, TheFinalPassIntegratesEachKeyframeOnceWithItsFinalPose) {
+  std::vector<std::size_t> points[2];  // [online, final pass]: points per keyframe
+  for (const bool final_pass : {true, false}) {
     FakeLog log;
     log.released = true;
     TimingRecorder timings;
     StaticPointsOptions options = countingOptions();
-    options.deferred_integration = deferred;
+    options.visibility_final_pass = final_pass;
     MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate),
                          SyntheticScene::camera(), options, 4, &timings);
     std::vector<PoseUpdate> updates;
@@ -240,29 +241,57 @@ TEST(MappingWorker, DeferredIntegrationIntegratesEachKeyframeOnceWithItsFinalPos
       worker.push(kf);
       updates.push_back({id, Eigen::Translation3d(0.05, 0, 0) * kf->T_W_C});
     }
+    worker.drain();
     worker.applyPoseUpdates(updates);
     worker.finish();
-    if (deferred) {
+    if (final_pass) {
       EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3}));
       EXPECT_EQ(log.resets, 0);
-      EXPECT_EQ(timings.stats("mapping_keyframe").count, 4u);
     } else {
       EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3, 0, 1, 2, 3}));
       EXPECT_EQ(log.resets, 1);
-      EXPECT_EQ(timings.stats("mapping_keyframe").count, 0u);
     }
-    // One timed backend integration per keyframe either way (deferred: those of finish()).
+    EXPECT_EQ(timings.stats("mapping_keyframe").count, 4u);
+    // One timed backend integration per keyframe either way (final pass: those of finish()).
     EXPECT_EQ(timings.stats("mapping_integrate").count, 4u);
     for (const auto& u : updates) EXPECT_TRUE(log.poses.at(u.keyframe_id).isApprox(u.T_W_C));
-    // Points from the stored static depth: as many as the live integration got on arrival.
     ASSERT_GE(log.points.size(), 4u);
-    points[deferred ? 1 : 0].assign(log.points.end() - 4, log.points.end());
-    if (!deferred) {
+    points[final_pass ? 1 : 0].assign(log.points.end() - 4, log.points.end());
+    if (!final_pass) {
       EXPECT_EQ(points[0], std::vector<std::size_t>(log.points.begin(), log.points.begin() + 4));
     }
   }
   EXPECT_EQ(points[1], points[0]);
   EXPECT_GT(points[1].front(), 1000u);
+}
+
+// Online, a keyframe goes to the backend once a keyframe window_after_s later has arrived,
+// judged against those within window_before_s before it; a kInPlace backend gets the pose
+// updates of the integrated ones, and the worker keeps no image of theirs.
+TEST(MappingWorker, OnlineKeyframesReachTheBackendOnceTheirWindowIsThere) {
+  FakeLog log;
+  log.released = true;
+  StaticPointsOptions options = countingOptions();
+  options.free_space.enabled = false;
+  options.window_after_s = 0.25;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), options, 4, nullptr);
+  for (std::uint64_t id = 0; id < 6; ++id) {
+    auto kf = std::make_shared<KeyframePacket>(*packet(id));
+    kf->timestamp_s = 0.1 * static_cast<double>(id);
+    worker.push(kf);
+  }
+  worker.waitIdle();
+  {
+    std::lock_guard<std::mutex> lock(log.mutex);  // 0.5 s: keyframes at 0.0, 0.1, 0.2
+    EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2}));
+  }
+  const Eigen::Isometry3d moved = Eigen::Translation3d(0.0, 0.02, 0.0) * packet(1)->T_W_C;
+  worker.applyPoseUpdates({{1, moved}});
+  worker.finish();
+  EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 5}));
+  EXPECT_TRUE(log.poses.at(1).isApprox(moved));
+  EXPECT_EQ(log.resets, 0);
 }
 
 // A backend whose cells are votes over views gets the mask grown by fused_mask_dilation_px (3),
@@ -272,7 +301,6 @@ TEST(MappingWorker, FusingBackendsGetTheNarrowerMaskMargin) {
     FakeLog log;
     log.released = true;
     StaticPointsOptions options = countingOptions();
-    options.deferred_integration = false;
     options.fused_mask_dilation_px = fused_px;
     MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace, fuses),
                          SyntheticScene::camera(), options, 4, nullptr);

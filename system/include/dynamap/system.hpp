@@ -37,9 +37,12 @@ struct SystemCounts {
   std::size_t frames = 0;  ///< frames given to track() / mapWithPose() / markBadFrame()
   std::size_t tracked = 0, relocalized = 0, lost = 0, bad_frames = 0;
   std::size_t keyframes = 0;
-  /// Integrated by the backend: final after finish(); 0 before it with deferred integration
-  /// (mapping.deferred_integration, the default), where the backend gets them in finish().
+  /// Integrated by the backend so far: a keyframe is, about mapping.window_after_s after its
+  /// frame (once judged); all of them after finish(). With mapping.visibility_final_pass the
+  /// backend gets them only in finish() (0 before).
   std::size_t mapped_keyframes = 0;
+  std::size_t map_elements = 0;  ///< the backend's points, voxels or cells so far
+
   std::size_t mapper_dropped = 0;  ///< SystemOptions::drop_keyframes_when_busy only
 };
 
@@ -132,6 +135,11 @@ class System {
   std::unordered_map<std::uint64_t, cv::Mat> revisedMasks() const;
   /// finish(), then writes the backend's map files into `dir` (created if needed).
   void exportMap(const std::string& dir);
+  /// The map as it is now, during the run, without finishing: waits until the mapper has taken
+  /// the keyframes handed to it so far, then writes the backend's files into `dir` (created if
+  /// needed). The keyframes of the last mapping.window_after_s are not in it yet. After
+  /// finish(), the final map.
+  void exportMapSnapshot(const std::string& dir);
 
   /// Per-stage timings of every thread so far (SystemOptions::timings when given).
   const TimingRecorder& timings() const;

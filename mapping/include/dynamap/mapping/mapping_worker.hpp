@@ -19,25 +19,26 @@
 
 namespace dynamap {
 
-/// Runs a backend on its own thread behind a bounded queue of keyframe packets. Pose updates
-/// from bundle adjustment are forwarded to the backend; volumetric backends (kReintegrate) are
-/// rebuilt with the final poses in finish() when some keyframe moved by more than
-/// `kReintegrateTranslationM` / `kReintegrateRotationRad`. For that the worker keeps each
-/// keyframe's static depth (16-bit, 0.2 mm) and colour. With options.free_space enabled, a
-/// keyframe is integrated once its `neighbours` later keyframes have arrived (or at finish()),
-/// without the pixels that lie in free space seen by up to `neighbours` keyframes on each side
-/// (freeSpaceViolations(): movers the masks missed). With options.visibility enabled, finish()
-/// checks every map element against every keyframe with the final poses (removeSeenThrough():
-/// what any keyframe saw through is removed) and rebuilds the map without it, whatever the
-/// backend; for that it keeps every keyframe's static depth, colour and a 1/downsample
-/// resolution view of its depth (VisibilityView); and with options.deferred_integration (the
-/// default) the backend sees the keyframes only then, after the pass, with the final poses: the
-/// mapping thread keeps their static depth and views while the camera runs. All public methods are
-/// thread-safe; exportMap() and stats() after finish() see the final map.
+/// Runs a backend on its own thread behind a bounded queue of keyframe packets. With
+/// options.free_space enabled, a keyframe first waits for its `neighbours` later keyframes and
+/// loses the pixels that lie in free space seen by up to `neighbours` keyframes on each side
+/// (freeSpaceViolations(): movers the masks missed). Then, online (the default), it waits in the
+/// judgement window until a keyframe options.window_after_s later has arrived: its held-back
+/// pixels are revised (heldConfirmedElsewhere()) and what the keyframes within window_before_s
+/// before and window_after_s after it saw through or voted out is removed (removeSeenThrough()),
+/// all with the current poses, and it goes to the backend. Pose updates go to the backend as they
+/// come (kInPlace); volumetric backends (kReintegrate) are rebuilt in finish() when some keyframe
+/// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad` (for that the worker
+/// keeps their keyframes' static depth, 16-bit, and colour; a kInPlace backend's are released
+/// once integrated, the views once out of the window). With options.visibility_final_pass (the
+/// offline extra) the keyframes go to the backend only in finish(), after the held revision and
+/// the visibility pass over all of them with the final poses. All public methods are thread-safe;
+/// exportMap() and stats() see the map as it is (final after finish()).
 class MappingWorker {
  public:
   static constexpr double kReintegrateTranslationM = 0.01;
   static constexpr double kReintegrateRotationRad = 0.5 * 3.14159265358979 / 180.0;
+  static constexpr std::uint64_t kSupplementBit = std::uint64_t{1} << 63;
 
   MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
                 const StaticPointsOptions& options, std::size_t queue_capacity,
@@ -58,12 +59,15 @@ class MappingWorker {
   void drain();
   /// Drains the queue, stops the thread, applies the final poses (rebuild if needed). Idempotent.
   void finish();
+  /// Blocks until the keyframes queued so far have been taken and processed (those still in a
+  /// window wait there): a snapshot then holds every keyframe old enough.
+  void waitIdle();
   void exportMap(const std::string& dir);
   MapStats stats() const;
   std::size_t droppedKeyframes() const { return dropped_.load(); }
   /// Keyframes re-integrated by the final rebuild (0 if none was needed).
   std::size_t reintegratedKeyframes() const;
-  /// The visibility pass of finish() (all zero before finish() or when it is disabled).
+  /// The visibility votes so far (online: summed over the windows; final pass: after finish()).
   VisibilityResult visibilityResult() const;
   /// After finish(): the masks that the held-back revision changed (keyframe id -> the mask the
   /// map used), see StaticPointsOptions::held_revision_voxel_m.
@@ -83,6 +87,13 @@ class MappingWorker {
     cv::Mat held_depth_u16;
     cv::Mat dynamic_mask;
     cv::Mat extra_mask;
+    bool integrated = false;  ///< the backend has it
+    /// Online: integrated with held pixels kept for a second look once the keyframes
+    /// options.held_window_after_s later are there (the pixels unmasked then go to the backend
+    /// as keyframe id | kSupplementBit); `held_hits` are the first look's.
+    bool rejudge_held = false;
+    bool supplemented = false;
+    cv::Mat held_hits;
   };
   struct WindowEntry {
     KeyframePacketPtr kf;
@@ -93,7 +104,26 @@ class MappingWorker {
   /// Adds a keyframe to the free-space window and integrates those whose neighbours are there
   /// (all of them when `flush`).
   void advanceWindow(KeyframePacketPtr kf, bool flush);
+  /// Makes the keyframe's record; online, puts it into the judgement window.
   void integratePacket(const KeyframePacket& kf, const cv::Mat& extra_mask);
+  /// Online: judges the keyframes of the window whose later keyframes are there (all when
+  /// `flush`) and integrates them (mapping_window.cpp).
+  void judgeReadyLocked(bool flush);
+  void reviseHeldWindowLocked(std::size_t begin, std::size_t end);
+  void removeSeenThroughWindowLocked(std::size_t begin, std::size_t end);
+  void integrateRecordLocked(std::uint64_t id);
+  /// Unmasks keyframe `id`'s pixels `hit` (held back, confirmed static elsewhere) and remakes its
+  /// static depth from `depth_m` (its raw depth); releases its held-revision data unless
+  /// `keep_held`. Returns the revised mask (empty if none). Touches only that record.
+  cv::Mat reviseOneLocked(std::uint64_t id, const cv::Mat& hit, const cv::Mat& depth_m,
+                          bool keep_held);
+  /// The held pixels' second look (see KeyframeRecord::rejudge_held) for the records due.
+  void rejudgeHeldLocked(bool flush);
+  /// heldConfirmedElsewhere() over the window for the window's keyframes [begin, end) (their
+  /// raw depth as metres in `depth_m`, one per window entry; empty for the others).
+  std::vector<cv::Mat> heldHitsLocked(std::size_t begin, std::size_t end,
+                                      std::vector<cv::Mat>& depth_m);
+  void addVisibilityTimings(const VisibilityResult& r);
   /// Rebuilds when a volumetric backend's keyframe moved, or always when `force`.
   void rebuildIfNeeded(bool force);
   /// The visibility pass over all keyframes; true if it removed pixels.
@@ -103,7 +133,11 @@ class MappingWorker {
   void prepareHeldLocked();
   void applyUpdateLocked(const PoseUpdate& update);
   /// Keyframes go to the backend only in finish() (see the class comment).
-  bool deferred() const { return options_.visibility.enabled && options_.deferred_integration; }
+  bool deferred() const { return options_.visibility_final_pass; }
+  /// The backend needs the stored keyframes again for a rebuild.
+  bool keepsDepth() const {
+    return deferred() || backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate;
+  }
 
   std::unique_ptr<MapBackend> backend_;
   PinholeCamera camera_;
@@ -112,9 +146,11 @@ class MappingWorker {
   int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
-  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, stopping_
+  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, stopping_, busy_
   std::condition_variable not_empty_;
   std::condition_variable not_full_;
+  std::condition_variable idle_;
+  bool busy_ = false;  ///< the thread is processing what it took from the queue
   std::deque<KeyframePacketPtr> queue_;
   std::vector<PoseUpdate> pending_updates_;
   bool stopping_ = false;
@@ -125,8 +161,11 @@ class MappingWorker {
 
   mutable std::mutex backend_mutex_;  ///< guards backend_ and records_
   std::unordered_map<std::uint64_t, KeyframeRecord> records_;
-  std::deque<WindowEntry> window_;  ///< mapping thread (then finish()) only
-  std::vector<std::uint64_t> order_;
+  std::deque<WindowEntry> window_;    ///< mapping thread (then finish()) only
+  std::vector<std::uint64_t> order_;  ///< every keyframe recorded, in order
+  /// Online: the judgement window in time order; [0, judged_) are judged context.
+  std::deque<std::uint64_t> judge_;
+  std::size_t judged_ = 0;
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
   VisibilityResult visibility_;

@@ -25,15 +25,23 @@ struct StaticPointsOptions {
   double depth_edge_threshold_m = 0.05;  ///< |depth jump| to a 4-neighbour marking an edge
   int stride = 1;                        ///< pixel step of points_C (static_depth_m is full)
   FreeSpaceOptions free_space;   ///< MappingWorker: drop pixels that violate neighbours' free space
-  VisibilityOptions visibility;  ///< MappingWorker::finish(): drop what any keyframe saw through
-  /// MappingWorker with `visibility` enabled: keyframes reach the backend only in finish(), after
-  /// the visibility pass, with the final poses (that pass rebuilds the map from the stored
-  /// keyframes whenever it removes anything, so integrating them on arrival as well was work
-  /// thrown away). false: each keyframe is also integrated when it arrives.
-  bool deferred_integration = true;
-  /// MappingWorker::finish(): a keyframe's held-back pixels (KeyframePacket::held_mask) whose
-  /// world point lies within this voxel's reach of an object another keyframe confirmed static
-  /// are unmasked (heldConfirmedElsewhere()). 0 = off.
+  VisibilityOptions visibility;  ///< MappingWorker: drop what other keyframes saw through
+  /// MappingWorker: each keyframe is judged (held revision, then the visibility votes) against
+  /// the keyframes within window_before_s (s) before and window_after_s after it, once a keyframe
+  /// window_after_s later has arrived (or in drain()), and integrated then.
+  double window_before_s = 3.0;
+  double window_after_s = 0.7;
+  /// ... and a keyframe's held-back pixels get a second look once the keyframes this long after
+  /// it are there (a standing person is often confirmed static only seconds later); what that
+  /// unmasks goes to the backend then. <= window_after_s: no second look.
+  double held_window_after_s = 3.0;
+  /// The offline extra (off by default): the visibility votes and the held revision over all
+  /// keyframes in finish(), with the final poses; the backend gets every keyframe only then, so
+  /// the map is empty during the run and finish() grows with the run.
+  bool visibility_final_pass = false;
+  /// MappingWorker (in the window above, or in the final pass): a keyframe's held-back pixels
+  /// (KeyframePacket::held_mask) whose world point lies within this voxel's reach of an object
+  /// another keyframe confirmed static are unmasked (heldConfirmedElsewhere()). 0 = off.
   double held_revision_voxel_m = 0.03;
   int held_revision_min_keyframes = 2;  ///< other keyframes that confirmed it there
 };
