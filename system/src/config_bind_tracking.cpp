@@ -45,6 +45,9 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_parallax_px", &c.kf_max_parallax_px, 1.0, 1000.0);
   schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
   schema.addDouble("tracking.kf_max_masked_share", &c.kf_max_masked_share, 0.0, 1.0);
+  schema.addDouble("tracking.kf_reuse_distance", &c.kf_reuse_distance, 0.0, 1.0);
+  schema.addDouble("tracking.kf_reuse_max_masked_gain", &c.kf_reuse_max_masked_gain, 0.0, 1.0);
+  schema.addDouble("tracking.kf_reuse_min_age_s", &c.kf_reuse_min_age_s, 0.0, 1e9);
 
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);

@@ -1,6 +1,7 @@
 #include "dynamap/core/tracking/local_map.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -13,13 +14,15 @@ std::uint64_t LocalMap::addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& d
 }
 
 std::uint64_t LocalMap::addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
-                                    std::vector<KeyframeObservation> observations) {
+                                    std::vector<KeyframeObservation> observations,
+                                    double masked_share) {
   std::lock_guard<std::mutex> lock(mutex_);
   MapKeyframe kf;
   kf.id = keyframes_.size();
   kf.timestamp_s = timestamp_s;
   kf.T_W_C = T_W_C;
   kf.observations = std::move(observations);
+  kf.masked_share = masked_share;
   for (const auto& o : kf.observations) ++landmarks_[o.landmark_id].keyframes;
   keyframes_.push_back(std::move(kf));
   return keyframes_.back().id;
@@ -113,21 +116,15 @@ std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
 void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
                                std::vector<Eigen::Vector3d>& points) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  ids.clear();
-  points.clear();
-  descriptors.release();
-  std::unordered_set<std::uint64_t> seen;
+  std::vector<std::uint64_t> newest;
   const int n = static_cast<int>(keyframes_.size());
   for (int k = n - 1; k >= std::max(0, n - keyframes); --k) {
-    for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
-      if (!seen.insert(o.landmark_id).second) continue;
-      const Landmark& lm = landmarks_[o.landmark_id];
-      if (lm.descriptor.empty() || lm.bad) continue;
-      ids.push_back(o.landmark_id);
-      points.push_back(lm.p_W);
-      descriptors.push_back(lm.descriptor);
-    }
+    newest.push_back(static_cast<std::uint64_t>(k));
   }
+  LandmarkCandidates c = landmarksOfLocked(newest);
+  ids = std::move(c.ids);
+  descriptors = c.descriptors;
+  points = std::move(c.points);
 }
 
 std::vector<KeyframeInfo> LocalMap::keyframes() const {
@@ -136,6 +133,59 @@ std::vector<KeyframeInfo> LocalMap::keyframes() const {
   out.reserve(keyframes_.size());
   for (const auto& kf : keyframes_) out.push_back(KeyframeInfo{kf.id, kf.timestamp_s, kf.T_W_C});
   return out;
+}
+
+std::vector<std::uint64_t> LocalMap::keyframesNear(const Eigen::Isometry3d& T_W_C,
+                                                   double max_translation_m,
+                                                   double max_rotation_deg,
+                                                   double latest_s) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::pair<double, std::uint64_t>> near;
+  const double max_rotation_rad = max_rotation_deg * M_PI / 180.0;
+  for (const auto& kf : keyframes_) {
+    if (kf.timestamp_s > latest_s) continue;
+    const Eigen::Isometry3d T_kf_C = kf.T_W_C.inverse() * T_W_C;
+    const double distance =
+        std::max(T_kf_C.translation().norm() / max_translation_m,
+                 Eigen::AngleAxisd(T_kf_C.linear()).angle() / max_rotation_rad);
+    if (distance <= 1.0) near.emplace_back(distance, kf.id);
+  }
+  std::sort(near.begin(), near.end());
+  std::vector<std::uint64_t> ids;
+  ids.reserve(near.size());
+  for (const auto& n : near) ids.push_back(n.second);
+  return ids;
+}
+
+LandmarkCandidates LocalMap::landmarksOf(const std::vector<std::uint64_t>& keyframe_ids) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return landmarksOfLocked(keyframe_ids);
+}
+
+LandmarkCandidates LocalMap::landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const {
+  LandmarkCandidates out;
+  std::unordered_set<std::uint64_t> seen;
+  for (const auto k : keyframe_ids) {
+    for (const auto& o : keyframes_.at(k).observations) {
+      if (!seen.insert(o.landmark_id).second) continue;
+      const Landmark& lm = landmarks_[o.landmark_id];
+      if (lm.descriptor.empty() || lm.bad) continue;
+      out.ids.push_back(o.landmark_id);
+      out.points.push_back(lm.p_W);
+      out.descriptors.push_back(lm.descriptor);
+    }
+  }
+  return out;
+}
+
+std::size_t LocalMap::observationCount(std::uint64_t keyframe_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return keyframes_.at(keyframe_id).observations.size();
+}
+
+double LocalMap::maskedShare(std::uint64_t keyframe_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return keyframes_.at(keyframe_id).masked_share;
 }
 
 }  // namespace dynamap

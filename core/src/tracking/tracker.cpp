@@ -61,12 +61,15 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
     Eigen::Isometry3d T_W_C = T_W_C_pred;
     result.status = solvePose(frame, gray, widened, T_W_C, result.inliers);
     if (result.status != FrameStatus::kLost) {
-      result.T_W_C = T_W_C;
       // Held-back objects (a teddy taken for a person) are no movers: they do not count. A pose
       // from depth alone bridges the frame: its features (few, near the movers) make no keyframe.
-      if (!posed_by_depth_ && needKeyframe(frame.timestamp_s, T_W_C, certainMask(filtered))) {
+      // A keyframe that is due where one already covers the view is not made (a revisit).
+      const cv::Mat movers = certainMask(filtered);
+      if (!posed_by_depth_ && needKeyframe(frame.timestamp_s, T_W_C, movers) &&
+          !reuseKeyframe(frame, gray, widened.dynamic_mask, movers, T_W_C, result.inliers)) {
         result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
       }
+      result.T_W_C = T_W_C;
     }
   }
   commitFrame(frame, gray, std::move(pyramid), result);

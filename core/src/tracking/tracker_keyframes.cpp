@@ -1,7 +1,6 @@
 // Pose estimation, relocalization, keyframes and bookkeeping of Tracker::Impl.
 #include <algorithm>
 #include <cmath>
-#include <unordered_set>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
@@ -113,12 +112,10 @@ bool Tracker::Impl::relocalize(const RgbdFrame& frame, const cv::Mat& gray,
 bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                                  const cv::Mat& movers) const {
   const auto n = static_cast<double>(tracks_.size());
-  if (n < config_.min_tracked_features || n < config_.kf_min_tracked_ratio * ref_tracks_) {
+  if (n < ref_min_tracks_ || n < config_.kf_min_tracked_ratio * ref_tracks_) {
     // Few tracks in a frame the movers fill mean nothing new to map: what is left unmasked is
     // little and near the movers, and the tracks come back when they leave.
-    const double share =
-        movers.empty() ? 0.0 : cv::countNonZero(movers) / static_cast<double>(movers.total());
-    if (share <= config_.kf_max_masked_share) return true;
+    if (maskedShare(movers) <= config_.kf_max_masked_share) return true;
   }
   const Eigen::Isometry3d T_ref_C = ref_T_W_C_.inverse() * T_W_C;
   if (T_ref_C.translation().norm() > config_.kf_max_translation_m) return true;
@@ -145,17 +142,8 @@ std::vector<int> Tracker::Impl::searchLocalMap(const OrbFeatures& features,
     return std::vector<int>(features.keypoints.size(), -1);
   }
   ScopedStageTimer timer(timings_, "local_search");
-  LandmarkCandidates all;
-  map_.relocCandidates(config_.local_search_keyframes, all.ids, all.descriptors, all.points);
-  std::unordered_set<std::uint64_t> tracked;
-  for (const auto& t : tracks_) tracked.insert(t.landmark_id);
-  LandmarkCandidates c;
-  for (std::size_t i = 0; i < all.ids.size(); ++i) {
-    if (tracked.count(all.ids[i])) continue;
-    c.ids.push_back(all.ids[i]);
-    c.points.push_back(all.points[i]);
-    c.descriptors.push_back(all.descriptors.row(static_cast<int>(i)));
-  }
+  const LandmarkCandidates c =
+      withoutLandmarks(map_.landmarksOf(localKeyframes(T_W_C)), trackedLandmarks());
   LandmarkSearchParams params;
   params.radius_px = config_.local_search_radius_px;
   params.max_hamming = config_.local_search_max_hamming;
@@ -209,11 +197,13 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     tracks_.push_back(FeatureTrack{id, p, p});
     observations.push_back({id, Eigen::Vector2d(p.x, p.y), z});
   }
-  const std::uint64_t kf_id = map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations));
+  const std::uint64_t kf_id = map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations),
+                                               maskedShare(certainMask(filtered)));
   ref_kf_ = kf_id;
   ref_T_W_C_ = T_W_C;
   ref_timestamp_s_ = frame.timestamp_s;
   ref_tracks_ = tracks_.size();
+  ref_min_tracks_ = config_.min_tracked_features;
   for (auto& t : tracks_) t.px_ref = t.px;
   if (config_.bundle_adjustment && !finished_) ba_.requestRun();
 

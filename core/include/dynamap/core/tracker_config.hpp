@@ -80,6 +80,19 @@ struct TrackerConfig {
   /// tracks (min_tracked_features, kf_min_tracked_ratio), only for the motion, time and parallax
   /// limits above (1 = always).
   double kf_max_masked_share = 0.35;
+  /// Revisits: when a keyframe is due, the nearest keyframe within this share of the
+  /// translation and rotation limits above becomes the reference again if the frame, with the
+  /// landmarks of the keyframes near it found again, tracks kf_min_tracked_ratio x
+  /// min_tracked_features points (2 x min_inliers after RANSAC), instead of a new keyframe with
+  /// new landmarks beside the old ones: keyframes grow with the space explored, not with time
+  /// (0 = off).
+  double kf_reuse_distance = 0.5;
+  /// ... unless its motion mask covered more than this share of the image more than the
+  /// frame's does: the new view shows static scene the old one had masked.
+  double kf_reuse_max_masked_gain = 0.1;
+  /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
+  /// The keyframes of one pass give the map its views of movers from several times.
+  double kf_reuse_min_age_s = 5.0;
 
   // --- local bundle adjustment (own thread) ---
   bool bundle_adjustment = true;  ///< local BA on its own thread

@@ -18,6 +18,10 @@ struct LandmarkCandidates {
   std::vector<Eigen::Vector3d> points;
 };
 
+/// `all` without the landmarks in `ids`.
+LandmarkCandidates withoutLandmarks(const LandmarkCandidates& all,
+                                    const std::vector<std::uint64_t>& ids);
+
 struct LandmarkSearchParams {
   double radius_px = 10.0;        ///< keypoint within this distance of the projection
   int max_hamming = 50;           ///< descriptor distance gate

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <mutex>
 #include <vector>
@@ -9,6 +10,7 @@
 
 #include "dynamap/core/frame.hpp"
 #include "dynamap/core/tracker.hpp"
+#include "dynamap/core/tracking/landmark_search.hpp"
 
 namespace dynamap {
 
@@ -31,6 +33,7 @@ struct MapKeyframe {
   double timestamp_s = 0.0;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::vector<KeyframeObservation> observations;
+  double masked_share = 0.0;  ///< share of its image under the motion mask when it was made
 };
 
 /// A copy of the sliding window handed to bundle adjustment (no lock held while solving).
@@ -55,7 +58,8 @@ class LocalMap {
  public:
   std::uint64_t addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& descriptor);
   std::uint64_t addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
-                            std::vector<KeyframeObservation> observations);
+                            std::vector<KeyframeObservation> observations,
+                            double masked_share = 0.0);
   std::size_t keyframeCount() const;
   Eigen::Isometry3d keyframePose(std::uint64_t id) const;
   /// Landmarks observed inside a dynamic region: left out of BA and relocalization from now on.
@@ -78,7 +82,20 @@ class LocalMap {
                        std::vector<Eigen::Vector3d>& points) const;
   std::vector<KeyframeInfo> keyframes() const;
 
+  /// Keyframes whose pose is within `max_translation_m` and `max_rotation_deg` of T_W_C, made
+  /// at `latest_s` or before, the nearest first (by the larger of the two distances, each over
+  /// its limit).
+  std::vector<std::uint64_t> keyframesNear(const Eigen::Isometry3d& T_W_C,
+                                           double max_translation_m, double max_rotation_deg,
+                                           double latest_s = INFINITY) const;
+  /// The good landmarks those keyframes observed, each once, in the keyframes' order.
+  LandmarkCandidates landmarksOf(const std::vector<std::uint64_t>& keyframe_ids) const;
+  std::size_t observationCount(std::uint64_t keyframe_id) const;
+  double maskedShare(std::uint64_t keyframe_id) const;
+
  private:
+  LandmarkCandidates landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const;
+
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
   std::vector<MapKeyframe> keyframes_;

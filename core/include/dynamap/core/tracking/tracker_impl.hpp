@@ -32,6 +32,9 @@ struct FrameRecord {
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();    ///< used otherwise
 };
 
+/// Share of the image's pixels that `mask` (CV_8UC1, may be empty) sets.
+double maskedShare(const cv::Mat& mask);
+
 class Tracker::Impl {
  public:
   Impl(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings);
@@ -96,6 +99,18 @@ class Tracker::Impl {
   /// `movers`: the frame's motion mask without held-back objects (kf_max_masked_share).
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                     const cv::Mat& movers) const;
+  /// A revisit: the nearest keyframe that covers the view becomes the reference again and the
+  /// frame tracks its landmarks (pose refined with them); false (nothing changed) if none does.
+  bool reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
+                     const cv::Mat& movers, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
+  std::vector<std::uint64_t> localKeyframes(const Eigen::Isometry3d& T_W_C) const;
+  std::vector<std::uint64_t> trackedLandmarks() const;
+  std::vector<FeatureTrack> findMapLandmarks(const RgbdFrame& frame, const cv::Mat& gray,
+                                             const cv::Mat& track_mask,
+                                             const Eigen::Isometry3d& T_W_C);
+  /// Adds the re-found landmarks' tracks; tracks on the same points (newer landmarks) go.
+  void mergeTracks(const std::vector<FeatureTrack>& found);
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
                                   const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
   /// New landmarks come from outside `track_mask`; the packet carries the filter's masks.
@@ -138,6 +153,9 @@ class Tracker::Impl {
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
   double ref_timestamp_s_ = 0.0;
   std::size_t ref_tracks_ = 0;
+  /// Fewer tracks than this make a keyframe due: min_tracked_features, lower after a revisit
+  /// of a keyframe with fewer points (reuseKeyframe()).
+  double ref_min_tracks_ = 0.0;
 
   std::vector<FrameRecord> records_;
   std::vector<double> bad_frames_;  ///< markBadFrame()'s timestamps (frames without a record)

@@ -1,0 +1,138 @@
+// Revisits: where the map already has a keyframe that covers the view, a keyframe that is due
+// is not made; that keyframe becomes the reference again and its landmarks are tracked, instead
+// of new landmarks beside the old ones. Keyframes grow with the space explored, not with time.
+#include <algorithm>
+
+#include "dynamap/core/tracking/depth_sampling.hpp"
+#include "dynamap/core/tracking/landmark_search.hpp"
+#include "dynamap/core/tracking/tracker_impl.hpp"
+
+namespace dynamap {
+namespace {
+
+/// The landmarks of this many of the nearest keyframes are matched to the frame.
+constexpr std::size_t kReuseSourceKeyframes = 8;
+
+}  // namespace
+
+// A track within kSamePointPx of a re-found landmark follows the same point under a newer
+// landmark: the older one takes its place.
+void Tracker::Impl::mergeTracks(const std::vector<FeatureTrack>& found) {
+  constexpr float kSamePointPx = 2.0f;
+  std::vector<FeatureTrack> kept;
+  kept.reserve(tracks_.size() + found.size());
+  for (const auto& t : tracks_) {
+    const bool same = std::any_of(found.begin(), found.end(), [&](const FeatureTrack& f) {
+      const cv::Point2f d = f.px - t.px;
+      return d.x * d.x + d.y * d.y <= kSamePointPx * kSamePointPx;
+    });
+    if (!same) kept.push_back(t);
+  }
+  kept.insert(kept.end(), found.begin(), found.end());
+  tracks_.swap(kept);
+}
+
+double maskedShare(const cv::Mat& mask) {
+  return mask.empty() ? 0.0 : cv::countNonZero(mask) / static_cast<double>(mask.total());
+}
+
+std::vector<std::uint64_t> Tracker::Impl::trackedLandmarks() const {
+  std::vector<std::uint64_t> ids;
+  ids.reserve(tracks_.size());
+  for (const auto& t : tracks_) ids.push_back(t.landmark_id);
+  return ids;
+}
+
+std::vector<std::uint64_t> Tracker::Impl::localKeyframes(const Eigen::Isometry3d& T_W_C) const {
+  std::vector<std::uint64_t> ids;
+  const auto n = static_cast<std::int64_t>(map_.keyframeCount());
+  for (std::int64_t k = n - 1; k >= std::max<std::int64_t>(0, n - config_.local_search_keyframes);
+       --k) {
+    ids.push_back(static_cast<std::uint64_t>(k));
+  }
+  if (config_.kf_reuse_distance <= 0.0) return ids;
+  for (const auto k : map_.keyframesNear(T_W_C, config_.kf_max_translation_m,
+                                         config_.kf_max_rotation_deg)) {
+    if (std::find(ids.begin(), ids.end(), k) == ids.end()) ids.push_back(k);
+  }
+  return ids;
+}
+
+// The landmarks of the keyframes near T_W_C that the frame's tracks do not follow, found among
+// the frame's ORB keypoints (outside track_mask) by projection.
+std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(const RgbdFrame& frame,
+                                                          const cv::Mat& gray,
+                                                          const cv::Mat& track_mask,
+                                                          const Eigen::Isometry3d& T_W_C) {
+  std::vector<std::uint64_t> sources =
+      map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
+  sources.resize(std::min(sources.size(), kReuseSourceKeyframes));
+  const LandmarkCandidates candidates =
+      withoutLandmarks(map_.landmarksOf(sources), trackedLandmarks());
+  OrbFeatures features;
+  {
+    ScopedStageTimer orb_timer(timings_, "orb");
+    cv::Mat allowed;
+    if (!track_mask.empty()) allowed = track_mask != 255;
+    features = extractor_.extractAll(gray, allowed);
+  }
+  std::vector<double> depth(features.keypoints.size());
+  for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
+    const cv::Point2f& p = features.keypoints[i].pt;
+    depth[i] = sampleDepth(frame.depth_m, p.x, p.y, config_.depth_min_m, config_.depth_max_m);
+  }
+  LandmarkSearchParams params;
+  params.radius_px = config_.local_search_radius_px;
+  params.max_hamming = config_.local_search_max_hamming;
+  const std::vector<int> match =
+      searchByProjection(features, depth, candidates, T_W_C, camera_, params);
+  std::vector<FeatureTrack> found;
+  for (std::size_t i = 0; i < match.size(); ++i) {
+    if (match[i] < 0) continue;
+    const cv::Point2f& p = features.keypoints[i].pt;
+    found.push_back(FeatureTrack{candidates.ids[static_cast<std::size_t>(match[i])], p, p});
+  }
+  return found;
+}
+
+bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
+                                  const cv::Mat& track_mask, const cv::Mat& movers,
+                                  Eigen::Isometry3d& T_W_C, int& inliers) {
+  if (config_.kf_reuse_distance <= 0.0) return false;
+  ScopedStageTimer timer(timings_, "keyframe_reuse");
+  const std::vector<std::uint64_t> near =
+      map_.keyframesNear(T_W_C, config_.kf_reuse_distance * config_.kf_max_translation_m,
+                         config_.kf_reuse_distance * config_.kf_max_rotation_deg,
+                         frame.timestamp_s - config_.kf_reuse_min_age_s);
+  if (near.empty()) return false;
+  const std::uint64_t kf = near.front();
+  if (map_.maskedShare(kf) > maskedShare(movers) + config_.kf_reuse_max_masked_gain) return false;
+
+  const std::vector<FeatureTrack> saved = tracks_;
+  mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C));
+  // The map covers the view if the frame then tracks kf_min_tracked_ratio of
+  // min_tracked_features points, and RANSAC keeps twice min_inliers of them.
+  const double needed =
+      config_.kf_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
+  Eigen::Isometry3d T = T_W_C;
+  int n = 0;
+  if (static_cast<double>(tracks_.size()) < needed || !estimatePose(frame, T, n) ||
+      static_cast<int>(tracks_.size()) < 2 * config_.min_inliers) {
+    tracks_ = saved;
+    return false;
+  }
+  T_W_C = T;
+  inliers = n;
+  ref_kf_ = kf;
+  ref_T_W_C_ = map_.keyframePose(kf);
+  ref_timestamp_s_ = frame.timestamp_s;
+  ref_tracks_ = tracks_.size();
+  // Fewer tracks than a new keyframe would give: the next one is due when they drop by as
+  // much as from any keyframe (kf_min_tracked_ratio), not at once below min_tracked_features.
+  ref_min_tracks_ = std::min(static_cast<double>(config_.min_tracked_features),
+                             config_.kf_min_tracked_ratio * static_cast<double>(ref_tracks_));
+  for (auto& t : tracks_) t.px_ref = t.px;
+  return true;
+}
+
+}  // namespace dynamap
