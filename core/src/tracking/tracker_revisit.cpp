@@ -2,6 +2,7 @@
 // is not made; that keyframe becomes the reference again and its landmarks are tracked, instead
 // of new landmarks beside the old ones. Keyframes grow with the space explored, not with time.
 #include <algorithm>
+#include <cmath>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
@@ -12,6 +13,15 @@ namespace {
 
 /// The landmarks of this many of the nearest keyframes are matched to the frame.
 constexpr std::size_t kReuseSourceKeyframes = 8;
+
+/// The pose with the old landmarks may correct drift, not jump: farther than this from the
+/// pose of the frame's own tracks, the matches are wrong.
+bool smallStep(const Eigen::Isometry3d& T_W_C, const Eigen::Isometry3d& T_W_C_reused) {
+  constexpr double kMaxStepM = 0.05, kMaxStepRad = 3.0 * M_PI / 180.0;
+  const Eigen::Isometry3d step = T_W_C.inverse() * T_W_C_reused;
+  return step.translation().norm() <= kMaxStepM &&
+         Eigen::AngleAxisd(step.linear()).angle() <= kMaxStepRad;
+}
 
 }  // namespace
 
@@ -117,7 +127,7 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
   Eigen::Isometry3d T = T_W_C;
   int n = 0;
   if (static_cast<double>(tracks_.size()) < needed || !estimatePose(frame, T, n) ||
-      static_cast<int>(tracks_.size()) < 2 * config_.min_inliers) {
+      static_cast<int>(tracks_.size()) < 2 * config_.min_inliers || !smallStep(T_W_C, T)) {
     tracks_ = saved;
     return false;
   }
