@@ -18,22 +18,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-/// A 6 x 6 m room (walls of 2 m panels, each its own texture) with boxes along the walls.
-void addLoopRoom(test::SyntheticScene& scene) {
-  for (int i = 0; i < 3; ++i) {
-    const double a = -3.0 + 2.0 * i;
-    scene.addPlane({a, -1.5, 3.0}, {2.0, 0, 0}, {0, 3.0, 0});    // far wall (+z)
-    scene.addPlane({a, -1.5, -3.0}, {2.0, 0, 0}, {0, 3.0, 0});   // near wall (-z)
-    scene.addPlane({-3.0, -1.5, a}, {0, 0, 2.0}, {0, 3.0, 0});   // left wall (-x)
-    scene.addPlane({3.0, -1.5, a}, {0, 0, 2.0}, {0, 3.0, 0});    // right wall (+x)
-    scene.addPlane({a, 1.5, -3.0}, {2.0, 0, 0}, {0, 0, 6.0});    // floor strip (y down)
-  }
-  scene.addBox({2.2, 0.9, 1.0}, {0.4, 0.6, 0.4});
-  scene.addBox({-2.3, 1.0, -1.2}, {0.3, 0.5, 0.5});
-  scene.addBox({0.8, 1.1, -2.3}, {0.5, 0.4, 0.3});
-  scene.addBox({-1.0, 0.8, 2.4}, {0.3, 0.7, 0.3});
-}
-
 TrackerConfig testConfig() { return TrackerConfig{}; }
 
 // Tolerances: end-point error after <= 20 % of before (the issue's >= 80 % reduction); every
@@ -42,7 +26,7 @@ TEST(LoopClosure, RevisitRemovesInjectedDrift) {
   const TrackerConfig config = testConfig();
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 21);
-  addLoopRoom(scene);
+  test::addLoopRoom(scene);
   GridOrbExtractor orb(config);
   TimingRecorder timings;
   LoopCloser closer(camera, config, LoopCloserConfig{}, &timings);

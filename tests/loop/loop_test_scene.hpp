@@ -19,6 +19,22 @@
 
 namespace dynamap::test {
 
+/// A 6 x 6 m room (walls of 2 m panels, each its own texture) with boxes along the walls.
+inline void addLoopRoom(test::SyntheticScene& scene) {
+  for (int i = 0; i < 3; ++i) {
+    const double a = -3.0 + 2.0 * i;
+    scene.addPlane({a, -1.5, 3.0}, {2.0, 0, 0}, {0, 3.0, 0});    // far wall (+z)
+    scene.addPlane({a, -1.5, -3.0}, {2.0, 0, 0}, {0, 3.0, 0});   // near wall (-z)
+    scene.addPlane({-3.0, -1.5, a}, {0, 0, 2.0}, {0, 3.0, 0});   // left wall (-x)
+    scene.addPlane({3.0, -1.5, a}, {0, 0, 2.0}, {0, 3.0, 0});    // right wall (+x)
+    scene.addPlane({a, 1.5, -3.0}, {2.0, 0, 0}, {0, 0, 6.0});    // floor strip (y down)
+  }
+  scene.addBox({2.2, 0.9, 1.0}, {0.4, 0.6, 0.4});
+  scene.addBox({-2.3, 1.0, -1.2}, {0.3, 0.5, 0.5});
+  scene.addBox({0.8, 1.1, -2.3}, {0.5, 0.4, 0.3});
+  scene.addBox({-1.0, 0.8, 2.4}, {0.3, 0.7, 0.3});
+}
+
 /// Nearest surface of all `scenes` at each pixel.
 inline RenderedFrame renderComposite(const std::vector<const SyntheticScene*>& scenes,
                                      const Eigen::Isometry3d& T_W_C, double t_s) {

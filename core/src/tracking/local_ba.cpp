@@ -97,6 +97,12 @@ bool LocalBundleAdjuster::solve(BaWindow& window) {
 
 void LocalBundleAdjuster::write(const BaWindow& solved) {
   std::vector<PoseUpdate> moved = map_.apply(solved);
+  if (moved.empty()) return;  // nothing free, or taken before a loop correction
+  if (listener_) listener_(moved, solved.generation);
+  queueUpdates(moved);
+}
+
+void LocalBundleAdjuster::queueUpdates(const std::vector<PoseUpdate>& moved) {
   std::lock_guard<std::mutex> lock(updates_mutex_);
   updates_.insert(updates_.end(), moved.begin(), moved.end());
 }

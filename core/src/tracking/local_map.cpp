@@ -5,6 +5,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "dynamap/core/tracking/loop_closer.hpp"
+
 namespace dynamap {
 
 std::uint64_t LocalMap::addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& descriptor) {
@@ -57,6 +59,18 @@ void LocalMap::landmarkPositions(const std::vector<std::uint64_t>& ids,
   for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].p_W;
 }
 
+void LocalMap::descriptorsOf(const std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
+                             std::vector<std::uint8_t>& bad) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  descriptors = cv::Mat(static_cast<int>(ids.size()), 32, CV_8UC1, cv::Scalar(0));
+  bad.assign(ids.size(), 0);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const Landmark& lm = landmarks_[ids[i]];
+    if (lm.descriptor.cols == 32) lm.descriptor.copyTo(descriptors.row(static_cast<int>(i)));
+    bad[i] = lm.bad || lm.descriptor.cols != 32 ? 1 : 0;
+  }
+}
+
 void LocalMap::keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector<int>& out) const {
   std::lock_guard<std::mutex> lock(mutex_);
   out.resize(ids.size());
@@ -66,6 +80,7 @@ void LocalMap::keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector
 BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
   std::lock_guard<std::mutex> lock(mutex_);
   BaWindow w;
+  w.generation = generation_;
   const int n = static_cast<int>(keyframes_.size());
   const int first_opt = std::max(0, n - window);
   const int first = std::max(0, first_opt - window);
@@ -102,6 +117,7 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
 std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<PoseUpdate> updates;
+  if (solved.generation != generation_) return updates;
   for (std::size_t k = 0; k < solved.keyframe_ids.size(); ++k) {
     if (solved.fixed[k]) continue;
     keyframes_[solved.keyframe_ids[k]].T_W_C = solved.poses[k];
@@ -111,6 +127,41 @@ std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
     landmarks_[solved.landmark_ids[i]].p_W = solved.points[i];
   }
   return updates;
+}
+
+std::vector<PoseUpdate> LocalMap::applyLoopCorrection(const LoopCorrection& correction) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<PoseUpdate> updates;
+  if (correction.keyframes.empty()) return updates;
+  // Per keyframe: the correction that moves it (left-multiplied, so a BA refinement made since
+  // the loop closer saw the pose is kept).
+  std::vector<Eigen::Isometry3d> move_of(keyframes_.size(),
+                                         correction.keyframes.back().correction());
+  for (const PoseCorrection& c : correction.keyframes) {
+    if (c.id < move_of.size()) move_of[c.id] = c.correction();
+  }
+  constexpr std::size_t kNoAnchor = ~std::size_t{0};
+  std::vector<std::size_t> anchor(landmarks_.size(), kNoAnchor);
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    for (const auto& o : keyframes_[k].observations) {
+      if (anchor[o.landmark_id] == kNoAnchor) anchor[o.landmark_id] = k;
+    }
+  }
+  for (std::size_t i = 0; i < landmarks_.size(); ++i) {
+    if (anchor[i] != kNoAnchor) landmarks_[i].p_W = move_of[anchor[i]] * landmarks_[i].p_W;
+  }
+  updates.reserve(keyframes_.size());
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    keyframes_[k].T_W_C = move_of[k] * keyframes_[k].T_W_C;
+    updates.push_back(PoseUpdate{keyframes_[k].id, keyframes_[k].T_W_C});
+  }
+  generation_ = correction.generation;
+  return updates;
+}
+
+int LocalMap::generation() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return generation_;
 }
 
 void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,

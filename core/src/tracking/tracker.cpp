@@ -33,12 +33,15 @@ Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
       lk_(config),
       optimizer_(camera, config),
       relocalizer_(config, optimizer_) {
+  startLoopClosure();  // before the BA thread: it hands the BA's moves on
   if (config_.bundle_adjustment) ba_.start();
 }
 
 // The per-frame step: match -> dynamic filter -> pose (with its fallbacks) -> keyframe -> commit.
 TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   ScopedStageTimer total(timings_, "tracking");
+  // Realtime: a loop correction lands as soon as it is ready (lockstep: at the next keyframe).
+  if (loop_ && !config_.ba_lockstep) applyLoopCorrections(loop_->takeCorrections(), nullptr);
   if (frame.depth_m.empty() || cv::countNonZero(frame.depth_m) == 0) return poseWithoutDepth(frame);
   if (filter_) filter_->beginFrame(frame);
   const cv::Mat gray = toGray(frame.bgr, camera_);
@@ -103,7 +106,8 @@ void Tracker::Impl::startMap(const RgbdFrame& frame, const cv::Mat& gray,
   tracks_.clear();
   // The first frame starts the map at the origin; a restart after a long loss starts a new
   // part of the map where the camera was last seen.
-  result.keyframe = createKeyframe(frame, gray, T_W_last_, filtered, initialMask(gray, widened));
+  Eigen::Isometry3d T_W_C = T_W_last_;  // a copy: a loop correction landing moves both
+  result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, initialMask(gray, widened));
   if (result.keyframe) {
     initialized_ = true;
     lost_streak_ = 0;
@@ -382,7 +386,10 @@ void Tracker::Impl::cullMovedLandmarks(const Eigen::Isometry3d& T_W_C) {
 Tracker::Tracker(const PinholeCamera& camera, const TrackerConfig& config, TimingRecorder* timings)
     : impl_(std::make_unique<Impl>(camera, config, timings)) {}
 
-Tracker::~Tracker() { impl_->ba_.stop(); }
+Tracker::~Tracker() {
+  impl_->ba_.stop();
+  if (impl_->loop_) impl_->loop_->stop();
+}
 
 void Tracker::setMotionFilter(MotionFilter* filter) { impl_->filter_ = filter; }
 TrackingResult Tracker::track(const RgbdFrame& frame) { return impl_->track(frame); }

@@ -152,7 +152,7 @@ std::vector<int> Tracker::Impl::searchLocalMap(const OrbFeatures& features,
 }
 
 KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
-                                                const Eigen::Isometry3d& T_W_C,
+                                                Eigen::Isometry3d& T_W_C,
                                                 const MotionFilterOutput& filtered,
                                                 const cv::Mat& track_mask) {
   const OrbFeatures features = extractOrb(gray, track_mask);
@@ -173,8 +173,12 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     }
   }
   if (!initialized_ && static_cast<int>(fresh.size()) < kMinInitialLandmarks) return nullptr;
-  // ba_lockstep: the last keyframe's BA result lands here, at a point fixed by the frames alone.
-  if (config_.bundle_adjustment && config_.ba_lockstep) ba_.applyFinished();
+  // ba_lockstep: the last keyframe's BA result and loop correction land here, at a point fixed
+  // by the frames alone.
+  if (config_.ba_lockstep) landLoopCorrections(&T_W_C);
+  const std::size_t old_tracks = tracks_.size();
+  std::vector<std::uint64_t> landmark_of(loop_ ? features.keypoints.size() : 0,
+                                         LoopKeyframe::kNoLandmark);
 
   std::vector<KeyframeObservation> observations;
   observations.reserve(tracks_.size() + fresh.size() + reseen.size());
@@ -186,6 +190,7 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
   for (const int i : reseen) {
     const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(i)].pt;
     const std::uint64_t id = seen_ids[static_cast<std::size_t>(seen[static_cast<std::size_t>(i)])];
+    if (loop_) landmark_of[static_cast<std::size_t>(i)] = id;
     tracks_.push_back(FeatureTrack{id, p, p});
     observations.push_back({id, Eigen::Vector2d(p.x, p.y), depth[static_cast<std::size_t>(i)]});
   }
@@ -194,6 +199,7 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     const double z = depth[static_cast<std::size_t>(i)];
     const Eigen::Vector3d p_W = T_W_C * camera_.backProject(p.x, p.y, z);
     const std::uint64_t id = map_.addLandmark(p_W, features.descriptors.row(i));
+    if (loop_) landmark_of[static_cast<std::size_t>(i)] = id;
     tracks_.push_back(FeatureTrack{id, p, p});
     observations.push_back({id, Eigen::Vector2d(p.x, p.y), z});
   }
@@ -206,6 +212,10 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
   ref_min_tracks_ = config_.min_tracked_features;
   for (auto& t : tracks_) t.px_ref = t.px;
   if (config_.bundle_adjustment && !finished_) ba_.requestRun();
+  if (loop_ && !finished_) {
+    feedLoopCloser(kf_id, frame, T_W_C, features, depth, landmark_of, old_tracks, filtered,
+                   track_mask);
+  }
 
   auto packet = std::make_shared<KeyframePacket>();
   packet->id = kf_id;
@@ -254,8 +264,10 @@ void Tracker::Impl::finish() {
   // The last keyframe's solve is waited for and written before the thread stops: stopped while
   // it was still pending it was dropped, while running it was kept, so the final poses depended
   // on thread timing (CI's consumer test under ctest -j2: 4.5e-6 m from the CLI's).
-  if (config_.bundle_adjustment) ba_.applyFinished();
+  // The last keyframe's loop pass too; its correction lands after that solve (as at keyframes).
+  landLoopCorrections(nullptr);
   ba_.stop();
+  if (loop_) loop_->stop();
   if (config_.bundle_adjustment) {
     ba_.applyFinished();  // not lockstep: a solve that finished meanwhile
     // Every keyframe (or the newest final_ba_window) at once: the local windows left the drift
@@ -285,8 +297,13 @@ std::vector<FrameStatus> Tracker::Impl::frameStatuses() const {
 }
 
 TrackerStats Tracker::Impl::stats() const {
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  return stats_;
+  TrackerStats out;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    out = stats_;
+  }
+  if (loop_) out.loops = loop_->stats().loops;
+  return out;
 }
 
 }  // namespace dynamap

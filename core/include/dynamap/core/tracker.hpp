@@ -38,6 +38,8 @@ struct TrackingResult {
 struct TrackerStats {
   std::size_t frames = 0, tracked = 0, relocalized = 0, lost = 0, keyframes = 0;
   std::size_t bad_frames = 0;
+  std::size_t loops = 0;          ///< loops verified by the loop closer (tracking.loop_closure)
+  std::size_t loop_closures = 0;  ///< pose-graph corrections applied
 };
 
 struct KeyframeInfo {

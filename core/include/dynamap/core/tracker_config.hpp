@@ -129,6 +129,15 @@ struct TrackerConfig {
   /// (depth_alignment.hpp); such frames make no keyframe and count as lost for the restart.
   /// Off: on the Bonn slice it removes every lost frame but raises the ATE (BENCHMARKS.md).
   bool depth_fallback = false;
+
+  // --- loop closure (own thread; core/include/dynamap/core/tracking/loop_closer.hpp) ---
+  /// Each keyframe's static ORB features (outside the widened motion mask and the held pixels,
+  /// not on bad landmarks) go to a loop closer on its own thread: place recognition, geometric
+  /// verification, an SE(3) pose graph. Its corrections move the keyframes, their landmarks,
+  /// the current pose, and reach the mapping backends as pose updates. With ba_lockstep a
+  /// correction found for keyframe k lands when keyframe k+1 is made (the tracker waits for the
+  /// loop thread there), so an offline run repeats exactly; without it at the next frame.
+  bool loop_closure = false;
 };
 
 }  // namespace dynamap

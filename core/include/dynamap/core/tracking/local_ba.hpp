@@ -1,6 +1,7 @@
 #pragma once
 
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -33,6 +34,12 @@ class LocalBundleAdjuster {
   LocalBundleAdjuster(const LocalBundleAdjuster&) = delete;
   LocalBundleAdjuster& operator=(const LocalBundleAdjuster&) = delete;
 
+  /// Told of every write to the map (the moved keyframes and the map generation the window was
+  /// taken in), on the thread that writes: the BA thread, or the caller of applyFinished() and
+  /// runOnce(). Set before start().
+  using WriteListener = std::function<void(const std::vector<PoseUpdate>&, int generation)>;
+  void setWriteListener(WriteListener listener) { listener_ = std::move(listener); }
+
   void start();
   void requestRun();
   void stop();  ///< finishes the running solve, joins; idempotent
@@ -40,6 +47,8 @@ class LocalBundleAdjuster {
   /// (0 = ba_window) with at most max_iterations (0 = ba_max_iterations).
   void runOnce(int window_keyframes = 0, int max_iterations = 0);
   std::vector<PoseUpdate> takeUpdates();
+  /// Poses moved by someone else (loop closure) join the queue of takeUpdates(), in order.
+  void queueUpdates(const std::vector<PoseUpdate>& moved);
   /// ba_lockstep: waits for the requested/running solve and writes its result to the map.
   void applyFinished();
 
@@ -53,6 +62,7 @@ class LocalBundleAdjuster {
   TrackerConfig config_;
   LocalMap& map_;
   TimingRecorder* timings_;
+  WriteListener listener_;  ///< set before start(), then read only
   std::mutex mutex_;
   std::condition_variable wake_;
   bool pending_ = false;

@@ -14,6 +14,8 @@
 
 namespace dynamap {
 
+struct LoopCorrection;  // loop_closer.hpp
+
 /// A 3D point in the world with the ORB descriptor of its first observation.
 struct Landmark {
   Eigen::Vector3d p_W;
@@ -50,6 +52,7 @@ struct BaWindow {
   std::vector<std::uint64_t> landmark_ids;
   std::vector<Eigen::Vector3d> points;
   std::vector<Observation> observations;
+  int generation = 0;  ///< LocalMap::generation() when taken: a stale window is not applied
 };
 
 /// Landmarks and keyframes shared by the tracking and BA threads. Every method is thread-safe;
@@ -68,14 +71,24 @@ class LocalMap {
   /// out[i] = position of ids[i].
   void landmarkPositions(const std::vector<std::uint64_t>& ids,
                          std::vector<Eigen::Vector3d>& out) const;
+  /// Row i of `descriptors` = the descriptor of ids[i]; bad[i] = 1 if it is marked bad.
+  void descriptorsOf(const std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
+                     std::vector<std::uint8_t>& bad) const;
   /// out[i] = number of keyframes that observed ids[i].
   void keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector<int>& out) const;
 
   /// The newest `window` keyframes; the oldest `fixed` of them and up to `window` older ones
   /// that see the same landmarks are held fixed.
   BaWindow snapshotWindow(int window, int fixed) const;
-  /// Writes optimised poses and points back; returns the moved keyframes.
+  /// Writes optimised poses and points back; returns the moved keyframes. A window taken
+  /// before a loop correction (solved.generation != generation()) is dropped: nothing moves.
   std::vector<PoseUpdate> apply(const BaWindow& solved);
+  /// Moves every keyframe by the loop correction (each listed keyframe by its own correction,
+  /// those newer than the newest listed by that one's) and each landmark with its anchor (the
+  /// first keyframe that observed it); generation() becomes correction.generation. Returns
+  /// the keyframes' new poses.
+  std::vector<PoseUpdate> applyLoopCorrection(const LoopCorrection& correction);
+  int generation() const;  ///< the newest loop correction applied (0 = none)
 
   /// Landmarks seen by the newest `keyframes` keyframes (ids, descriptors stacked, positions).
   void relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
@@ -99,6 +112,7 @@ class LocalMap {
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
   std::vector<MapKeyframe> keyframes_;
+  int generation_ = 0;
 };
 
 }  // namespace dynamap

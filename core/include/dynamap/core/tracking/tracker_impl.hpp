@@ -2,6 +2,7 @@
 
 // Internal state of dynamap::Tracker, shared by core/src/tracking/tracker*.cpp.
 
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "dynamap/core/tracking/lk_tracker.hpp"
 #include "dynamap/core/tracking/local_ba.hpp"
 #include "dynamap/core/tracking/local_map.hpp"
+#include "dynamap/core/tracking/loop_thread.hpp"
 #include "dynamap/core/tracking/pose_optimizer.hpp"
 #include "dynamap/core/tracking/relocalizer.hpp"
 
@@ -50,6 +52,7 @@ class Tracker::Impl {
   MotionFilter* filter_ = nullptr;
   LocalMap map_;
   LocalBundleAdjuster ba_;
+  std::unique_ptr<LoopClosureThread> loop_;  ///< tracking.loop_closure; null when off
 
  private:
   TrackingResult poseWithoutDepth(const RgbdFrame& frame);
@@ -114,10 +117,26 @@ class Tracker::Impl {
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
                                   const Eigen::Isometry3d& T_W_C, std::vector<std::uint64_t>& ids);
   /// New landmarks come from outside `track_mask`; the packet carries the filter's masks.
+  /// A loop correction landing here moves T_W_C.
   KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
-                                   const Eigen::Isometry3d& T_W_C,
+                                   Eigen::Isometry3d& T_W_C,
                                    const MotionFilterOutput& filtered, const cv::Mat& track_mask);
   OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
+  /// tracker_loop.cpp: the loop thread started, BA's moves forwarded to it (constructor).
+  void startLoopClosure();
+  /// The new keyframe's static features to the loop thread: the frame's new ORB keypoints
+  /// (`landmark_of`: their landmark, kNoLandmark if none) and the tracks it had before them.
+  void feedLoopCloser(std::uint64_t kf_id, const RgbdFrame& frame, const Eigen::Isometry3d& T_W_C,
+                      const OrbFeatures& features, const std::vector<double>& depth_m,
+                      const std::vector<std::uint64_t>& landmark_of, std::size_t old_tracks,
+                      const MotionFilterOutput& filtered, const cv::Mat& track_mask);
+  /// Loop corrections, oldest first, into the map and the tracker's state; `T_W_C_frame` (may
+  /// be null): the pose of the frame being tracked, moved as its reference keyframe.
+  void applyLoopCorrections(const std::vector<LoopCorrection>& corrections,
+                            Eigen::Isometry3d* T_W_C_frame);
+  /// ba_lockstep: waits for the loop thread (before the BA result lands), applies its
+  /// corrections after that; see createKeyframe().
+  void landLoopCorrections(Eigen::Isometry3d* T_W_C_frame);
   void record(double timestamp_s, FrameStatus status, const Eigen::Isometry3d& T_W_C);
   void countStatus(FrameStatus status, bool keyframe);
 
@@ -156,6 +175,8 @@ class Tracker::Impl {
   /// Fewer tracks than this make a keyframe due: min_tracked_features, lower after a revisit
   /// of a keyframe with fewer points (reuseKeyframe()).
   double ref_min_tracks_ = 0.0;
+
+  int loop_generation_ = 0;  ///< the newest loop correction applied (LoopCorrection::generation)
 
   std::vector<FrameRecord> records_;
   std::vector<double> bad_frames_;  ///< markBadFrame()'s timestamps (frames without a record)
