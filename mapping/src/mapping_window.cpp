@@ -9,6 +9,14 @@ namespace dynamap {
 namespace {
 
 constexpr double kDepthUnitsPerM = 5000.0;  // as mapping_worker.cpp's records
+constexpr double kRevisitReachM = 0.5;      // a kept view judges keyframes this near...
+constexpr double kRevisitReachRad = 30.0 * 3.14159265358979 / 180.0;  // ... and turned
+constexpr double kRevisitSpacingM = 0.1;  // a view is kept where no kept one is this near...
+constexpr double kRevisitSpacingRad = 10.0 * 3.14159265358979 / 180.0;  // ... and turned
+
+double angleRad(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.rotation().transpose() * b.rotation()).angle();
+}
 
 }  // namespace
 
@@ -17,21 +25,21 @@ void MappingWorker::judgeReadyLocked(bool flush) {
   const bool judging = options_.visibility.enabled || options_.held_revision_voxel_m > 0.0;
   const double after_s = judging ? options_.window_after_s : 0.0;
   const double newest_s = records_.at(judge_.back()).timestamp_s;
-  std::size_t end = judged_;  // targets: [judged_, end)
-  while (end < judge_.size() &&
+  std::size_t end = judged_;  // targets: [judged_, end), once the oldest waited a batch more
+  const bool due =
+      judged_ < judge_.size() && records_.at(judge_[judged_]).timestamp_s <=
+                                     newest_s - after_s - (judging ? options_.window_batch_s : 0.0);
+  while ((flush || due) && end < judge_.size() &&
          (flush || records_.at(judge_[end]).timestamp_s <= newest_s - after_s)) {
     ++end;
   }
-  if (end > judged_) {
-    {
-      ScopedStageTimer timer(timings_, "mapping_judge");
-      reviseHeldWindowLocked(judged_, end);
-      removeSeenThroughWindowLocked(judged_, end);
-    }
-    for (std::size_t i = judged_; i < end; ++i) integrateRecordLocked(judge_[i]);
-    judged_ = end;
+  if (end > judged_ || flush) {
+    ScopedStageTimer timer(timings_, "mapping_judge");
+    reviseHeldWindowLocked(judged_, end, flush);
+    if (end > judged_) removeSeenThroughWindowLocked(judged_, end);
   }
-  rejudgeHeldLocked(flush);
+  for (std::size_t i = judged_; i < end; ++i) integrateRecordLocked(judge_[i]);
+  judged_ = end;
   // Context older than window_before_s before the next keyframe to judge (or the last judged)
   // leaves the window: its view and confirmed points are released.
   const std::size_t next = std::min(judged_, judge_.size() - 1);
@@ -46,16 +54,20 @@ void MappingWorker::judgeReadyLocked(bool flush) {
         rec.bgr.release();
       }
     }
-    rec.view = VisibilityView();
+    if (keepForRevisitsLocked(rec)) {
+      revisit_.push_back(judge_.front());
+    } else {
+      rec.view = VisibilityView();
+    }
     rec.held = HeldKeyframe();
     judge_.pop_front();
     --judged_;
   }
 }
 
-std::vector<cv::Mat> MappingWorker::heldHitsLocked(std::size_t begin, std::size_t end,
+std::vector<cv::Mat> MappingWorker::heldHitsLocked(const std::vector<char>& looked,
                                                    std::vector<cv::Mat>& depth_m) {
-  // The window's points (moved out of the records and back); the targets' held pixels too.
+  // The window's points (moved out of the records and back); the held pixels of those looked at.
   std::vector<HeldKeyframe> keyframes(judge_.size());
   for (std::size_t i = 0; i < judge_.size(); ++i) {
     KeyframeRecord& rec = records_.at(judge_[i]);
@@ -63,7 +75,7 @@ std::vector<cv::Mat> MappingWorker::heldHitsLocked(std::size_t begin, std::size_
     k.T_W_C = rec.T_current;
     k.confirmed_C = std::move(rec.held.confirmed_C);
     k.moved_C = std::move(rec.held.moved_C);
-    if (i >= begin && i < end && !rec.held_depth_u16.empty()) {
+    if (looked[i] != 0 && !rec.held_depth_u16.empty()) {
       rec.held_depth_u16.convertTo(k.depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
       k.held = rec.held.held;
     }
@@ -79,13 +91,29 @@ std::vector<cv::Mat> MappingWorker::heldHitsLocked(std::size_t begin, std::size_
   return hits;
 }
 
-void MappingWorker::reviseHeldWindowLocked(std::size_t begin, std::size_t end) {
+void MappingWorker::reviseHeldWindowLocked(std::size_t begin, std::size_t end, bool flush) {
   if (options_.held_revision_voxel_m <= 0.0) return;
   ScopedStageTimer timer(timings_, "mapping_held_revision");
+  // First looks: [begin, end); second looks: the judged ones due (see rejudge_held).
+  const double due_s = records_.at(judge_.back()).timestamp_s - options_.held_window_after_s;
+  std::vector<char> looked(judge_.size(), 0);
+  bool any = begin < end;
+  for (std::size_t i = 0; i < judge_.size(); ++i) {
+    const KeyframeRecord& rec = records_.at(judge_[i]);
+    const bool second = i < begin && rec.rejudge_held && (flush || rec.timestamp_s <= due_s);
+    looked[i] = (i >= begin && i < end) || second ? 1 : 0;
+    any = any || second;
+  }
+  if (!any) return;
   std::vector<cv::Mat> depth_m(judge_.size());
-  const std::vector<cv::Mat> hits = heldHitsLocked(begin, end, depth_m);
+  const std::vector<cv::Mat> hits = heldHitsLocked(looked, depth_m);
   const bool second_look = options_.held_window_after_s > options_.window_after_s;
-  for (std::size_t i = begin; i < end; ++i) {
+  for (std::size_t i = 0; i < judge_.size(); ++i) {
+    if (looked[i] == 0) continue;
+    if (i < begin) {
+      secondLookLocked(judge_[i], hits[i], depth_m[i]);
+      continue;
+    }
     KeyframeRecord& rec = records_.at(judge_[i]);
     const bool keep = second_look && !depth_m[i].empty() && !rec.held.held.empty();
     const cv::Mat revised = reviseOneLocked(judge_[i], hits[i], depth_m[i], keep);
@@ -95,57 +123,55 @@ void MappingWorker::reviseHeldWindowLocked(std::size_t begin, std::size_t end) {
   }
 }
 
-void MappingWorker::rejudgeHeldLocked(bool flush) {
-  if (options_.held_revision_voxel_m <= 0.0 || judge_.empty()) return;
-  const double newest_s = records_.at(judge_.back()).timestamp_s;
-  for (std::size_t i = 0; i < judged_; ++i) {
-    const std::uint64_t id = judge_[i];
-    KeyframeRecord& rec = records_.at(id);
-    if (!rec.rejudge_held) continue;
-    if (!flush && rec.timestamp_s > newest_s - options_.held_window_after_s) continue;
-    ScopedStageTimer timer(timings_, "mapping_held_second_look");
-    std::vector<cv::Mat> depth_m(judge_.size());
-    const cv::Mat hit = heldHitsLocked(i, i + 1, depth_m)[i];
-    const cv::Mat fresh = hit.empty() || rec.held_hits.empty() ? hit : hit & ~rec.held_hits;
-    if (!fresh.empty() && cv::countNonZero(fresh) > 0) {
-      const cv::Mat all_hits = rec.held_hits.empty() ? hit : hit | rec.held_hits;
-      cv::Mat revised = rec.dynamic_mask.clone();
-      revised.setTo(0, all_hits);
-      revised_masks_[id] = revised;
-      const cv::Mat map_mask = rec.extra_mask.empty() ? revised : cv::max(revised, rec.extra_mask);
-      StaticPoints sp;  // only the pixels this look unmasked
-      sp.static_depth_m = staticDepth(depth_m[i], map_mask, options_);
-      sp.static_depth_m.setTo(0.0f, ~fresh);
-      if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
-        if (backend_->needsPoints()) {
-          backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                           &sp.colors);
-        }
-        backend_->integrate(keyframeView(id | kSupplementBit, rec.timestamp_s, rec.T_current,
-                                         camera_, rec.bgr, sp));
-        rec.supplemented = true;
-        cv::Mat more_u16;  // a rebuild integrates them with the rest
-        sp.static_depth_m.convertTo(more_u16, CV_16UC1, kDepthUnitsPerM);
-        rec.depth_u16 = cv::max(rec.depth_u16, more_u16);
+void MappingWorker::secondLookLocked(std::uint64_t id, const cv::Mat& hit, const cv::Mat& depth_m) {
+  KeyframeRecord& rec = records_.at(id);
+  const cv::Mat fresh = hit.empty() || rec.held_hits.empty() ? hit : hit & ~rec.held_hits;
+  if (!fresh.empty() && cv::countNonZero(fresh) > 0) {
+    const cv::Mat all_hits = rec.held_hits.empty() ? hit : hit | rec.held_hits;
+    cv::Mat revised = rec.dynamic_mask.clone();
+    revised.setTo(0, all_hits);
+    revised_masks_[id] = revised;
+    const cv::Mat map_mask = rec.extra_mask.empty() ? revised : cv::max(revised, rec.extra_mask);
+    StaticPoints sp;  // only the pixels this look unmasked
+    sp.static_depth_m = staticDepth(depth_m, map_mask, options_);
+    sp.static_depth_m.setTo(0.0f, ~fresh);
+    if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
+      if (backend_->needsPoints()) {
+        backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                         &sp.colors);
       }
+      backend_->integrate(
+          keyframeView(id | kSupplementBit, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
+      rec.supplemented = true;
+      ++supplements_;
+      cv::Mat more_u16;  // a rebuild integrates them with the rest
+      sp.static_depth_m.convertTo(more_u16, CV_16UC1, kDepthUnitsPerM);
+      rec.depth_u16 = cv::max(rec.depth_u16, more_u16);
     }
-    reviseOneLocked(id, cv::Mat(), cv::Mat(), false);  // releases the held data
-    rec.rejudge_held = false;
-    rec.held_hits.release();
-    if (!keepsDepth()) {
-      rec.depth_u16.release();
-      rec.bgr.release();
-    }
+  }
+  reviseOneLocked(id, cv::Mat(), cv::Mat(), false);  // releases the held data
+  rec.rejudge_held = false;
+  rec.held_hits.release();
+  if (!keepsDepth()) {
+    rec.depth_u16.release();
+    rec.bgr.release();
   }
 }
 
 void MappingWorker::removeSeenThroughWindowLocked(std::size_t begin, std::size_t end) {
   if (!options_.visibility.enabled) return;
   ScopedStageTimer timer(timings_, "mapping_visibility");
+  // Earlier visits' views first (they are older than the window), then the window's.
+  std::vector<std::uint64_t> ids =
+      revisitContextLocked(records_.at(judge_[(begin + end) / 2]).T_current);
+  const std::size_t offset = ids.size();
+  ids.insert(ids.end(), judge_.begin(), judge_.end());
+  begin += offset;
+  end += offset;
   std::vector<VisibilityKeyframe> keyframes;
-  keyframes.reserve(judge_.size());
-  for (std::size_t i = 0; i < judge_.size(); ++i) {
-    KeyframeRecord& rec = records_.at(judge_[i]);
+  keyframes.reserve(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    KeyframeRecord& rec = records_.at(ids[i]);
     VisibilityKeyframe k;
     k.static_depth = i >= begin && i < end ? &rec.depth_u16 : nullptr;  // others: views only
     k.metres_per_unit = 1.0 / kDepthUnitsPerM;
@@ -200,11 +226,42 @@ cv::Mat MappingWorker::reviseOneLocked(std::uint64_t id, const cv::Mat& hit, con
     staticDepth(depth_m, map_mask, options_).convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
   }
   if (keep_held) return revised;
-  rec.held = HeldKeyframe();  // done: its depth and masks are released
+  rec.held.depth_m.release();  // done: its depth and masks are released (its confirmed and
+  rec.held.held.release();     // moved points stay while the window holds it)
   rec.held_depth_u16.release();
   rec.dynamic_mask.release();
   rec.extra_mask.release();
   return revised;
+}
+
+bool MappingWorker::keepForRevisitsLocked(const KeyframeRecord& rec) const {
+  if (options_.window_revisit_keyframes <= 0 || rec.view.near_m.empty()) return false;
+  for (const std::uint64_t id : revisit_) {
+    const Eigen::Isometry3d& T = records_.at(id).T_current;
+    if ((T.translation() - rec.T_current.translation()).norm() < kRevisitSpacingM &&
+        angleRad(T, rec.T_current) < kRevisitSpacingRad) {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::uint64_t> MappingWorker::revisitContextLocked(
+    const Eigen::Isometry3d& T_W_C) const {
+  std::vector<std::pair<double, std::uint64_t>> near;  // (distance, id)
+  for (const std::uint64_t id : revisit_) {
+    const Eigen::Isometry3d& T = records_.at(id).T_current;
+    const double d = (T.translation() - T_W_C.translation()).norm();
+    if (d < kRevisitReachM && angleRad(T, T_W_C) < kRevisitReachRad) near.emplace_back(d, id);
+  }
+  const auto k = std::min(near.size(), static_cast<std::size_t>(options_.window_revisit_keyframes));
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
+  std::vector<std::uint64_t> ids;
+  for (std::size_t i = 0; i < k; ++i) ids.push_back(near[i].second);
+  std::sort(ids.begin(), ids.end(), [this](std::uint64_t a, std::uint64_t b) {
+    return records_.at(a).timestamp_s < records_.at(b).timestamp_s;
+  });
+  return ids;
 }
 
 void MappingWorker::addVisibilityTimings(const VisibilityResult& r) {

@@ -290,6 +290,7 @@ void MappingWorker::rebuildIfNeeded(bool force) {
   if (!moved) return;
   ScopedStageTimer timer(timings_, "mapping_rebuild");
   if (!deferred()) backend_->reset();  // deferred: the backend has had nothing yet
+  supplements_ = 0;                    // a record's depth holds its supplement
   // Keyframes are integrated in their order on this thread while the next one's points are made
   // on the other (it reads only its own record).
   const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
@@ -383,7 +384,9 @@ VisibilityResult MappingWorker::visibilityResult() const {
 
 MapStats MappingWorker::stats() const {
   std::lock_guard<std::mutex> lock(backend_mutex_);
-  return backend_->stats();
+  MapStats s = backend_->stats();
+  s.keyframes -= std::min(s.keyframes, supplements_);
+  return s;
 }
 
 std::size_t MappingWorker::reintegratedKeyframes() const {

@@ -84,6 +84,7 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   StaticPointsOptions options = countingOptions();
   options.free_space.enabled = false;  // integrate on arrival (no neighbour window)
   options.window_after_s = 0.0;        // ... nor judgement window
+  options.window_batch_s = 0.0;
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
                        SyntheticScene::camera(), options, 1, &timings);
   worker.push(packet(1));  // taken by the worker thread, which blocks in integrate()
@@ -274,6 +275,7 @@ TEST(MappingWorker, OnlineKeyframesReachTheBackendOnceTheirWindowIsThere) {
   StaticPointsOptions options = countingOptions();
   options.free_space.enabled = false;
   options.window_after_s = 0.25;
+  options.window_batch_s = 0.0;
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
                        SyntheticScene::camera(), options, 4, nullptr);
   for (std::uint64_t id = 0; id < 6; ++id) {
@@ -351,6 +353,48 @@ TEST(MappingWorker, HeldPixelsConfirmedByOtherKeyframesAreMappedAndTheirMaskRevi
   EXPECT_EQ(revised_on.size(), 1u);
   EXPECT_LT(cv::countNonZero(revised_on.at(0)), masked / 10);
   EXPECT_GT(on, off + static_cast<std::size_t>(masked) / 2);
+}
+
+// Online, a held-back box that only keyframes more than window_after_s later confirm static gets
+// its second look once keyframes held_window_after_s later are there: keyframe 0 goes to the
+// backend with the box masked, then the box's pixels follow as its supplement (its id with the
+// top bit), which pose updates reach too.
+TEST(MappingWorker, HeldPixelsConfirmedSecondsLaterFollowAsASupplement) {
+  FakeLog log;
+  log.released = true;
+  StaticPointsOptions options = countingOptions();
+  options.free_space.enabled = false;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), options, 4, nullptr);
+  const double stamps_s[] = {0.0, 1.5, 2.0, 3.5};
+  for (std::uint64_t id = 0; id < 4; ++id) {
+    auto kf = std::make_shared<KeyframePacket>(*packet(0));  // one view, four times
+    kf->id = id;
+    kf->timestamp_s = stamps_s[id];
+    if (id == 0) {
+      kf->held_mask = kf->dynamic_mask.clone();
+    } else {
+      kf->confirmed_mask = kf->dynamic_mask.clone();
+      kf->dynamic_mask = cv::Mat();
+    }
+    worker.push(kf);
+  }
+  worker.waitIdle();  // 3.5 s: keyframe 0 judged at 1.5 s (nobody confirmed it yet), looked again
+  const std::uint64_t supplement = 0 | MappingWorker::kSupplementBit;
+  {
+    std::lock_guard<std::mutex> lock(log.mutex);
+    ASSERT_GE(log.integrated.size(), 2u);
+    EXPECT_EQ(log.integrated[0], 0u);
+    EXPECT_NE(std::find(log.integrated.begin(), log.integrated.end(), supplement),
+              log.integrated.end());
+  }
+  const Eigen::Isometry3d moved = Eigen::Translation3d(0.0, 0.02, 0.0) * packet(0)->T_W_C;
+  worker.applyPoseUpdates({{0, moved}});
+  worker.finish();
+  EXPECT_TRUE(log.poses.at(supplement).isApprox(moved));
+  const auto revised = worker.revisedMasks();
+  ASSERT_EQ(revised.count(0), 1u);
+  EXPECT_LT(cv::countNonZero(revised.at(0)), cv::countNonZero(packet(0)->dynamic_mask) / 10);
 }
 
 }  // namespace

@@ -109,7 +109,9 @@ class MappingWorker {
   /// Online: judges the keyframes of the window whose later keyframes are there (all when
   /// `flush`) and integrates them (mapping_window.cpp).
   void judgeReadyLocked(bool flush);
-  void reviseHeldWindowLocked(std::size_t begin, std::size_t end);
+  /// The held revision's first look for the window's keyframes [begin, end) and the second look
+  /// for the judged ones due (all when `flush`), on one set of votes.
+  void reviseHeldWindowLocked(std::size_t begin, std::size_t end, bool flush);
   void removeSeenThroughWindowLocked(std::size_t begin, std::size_t end);
   void integrateRecordLocked(std::uint64_t id);
   /// Unmasks keyframe `id`'s pixels `hit` (held back, confirmed static elsewhere) and remakes its
@@ -117,13 +119,19 @@ class MappingWorker {
   /// `keep_held`. Returns the revised mask (empty if none). Touches only that record.
   cv::Mat reviseOneLocked(std::uint64_t id, const cv::Mat& hit, const cv::Mat& depth_m,
                           bool keep_held);
-  /// The held pixels' second look (see KeyframeRecord::rejudge_held) for the records due.
-  void rejudgeHeldLocked(bool flush);
-  /// heldConfirmedElsewhere() over the window for the window's keyframes [begin, end) (their
-  /// raw depth as metres in `depth_m`, one per window entry; empty for the others).
-  std::vector<cv::Mat> heldHitsLocked(std::size_t begin, std::size_t end,
+  /// The held pixels' second look (see KeyframeRecord::rejudge_held): integrates what `hit`
+  /// unmasks beyond the first look as the keyframe's supplement; releases its held data.
+  void secondLookLocked(std::uint64_t id, const cv::Mat& hit, const cv::Mat& depth_m);
+  /// heldConfirmedElsewhere() over the window for the window's keyframes with `looked` set
+  /// (their raw depth as metres in `depth_m`, one per window entry; empty for the others).
+  std::vector<cv::Mat> heldHitsLocked(const std::vector<char>& looked,
                                       std::vector<cv::Mat>& depth_m);
   void addVisibilityTimings(const VisibilityResult& r);
+  /// Online: whether a keyframe leaving the window keeps its view for later visits.
+  bool keepForRevisitsLocked(const KeyframeRecord& rec) const;
+  /// The kept views of earlier visits near `T_W_C` (options.window_revisit_keyframes), in time
+  /// order.
+  std::vector<std::uint64_t> revisitContextLocked(const Eigen::Isometry3d& T_W_C) const;
   /// Rebuilds when a volumetric backend's keyframe moved, or always when `force`.
   void rebuildIfNeeded(bool force);
   /// The visibility pass over all keyframes; true if it removed pixels.
@@ -166,8 +174,10 @@ class MappingWorker {
   /// Online: the judgement window in time order; [0, judged_) are judged context.
   std::deque<std::uint64_t> judge_;
   std::size_t judged_ = 0;
+  std::vector<std::uint64_t> revisit_;  ///< online: keyframes whose view is kept for revisits
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
+  std::size_t supplements_ = 0;  ///< held second looks in the backend (not counted as keyframes)
   VisibilityResult visibility_;
   std::unordered_map<std::uint64_t, cv::Mat> revised_masks_;
   std::thread thread_;

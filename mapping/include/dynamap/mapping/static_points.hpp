@@ -31,6 +31,13 @@ struct StaticPointsOptions {
   /// window_after_s later has arrived (or in drain()), and integrated then.
   double window_before_s = 3.0;
   double window_after_s = 0.7;
+  /// Keyframes are judged together once the oldest waiting one is this much older than
+  /// window_after_s (their voxels are shared: fewer projections per keyframe).
+  double window_batch_s = 0.3;
+  /// Views of earlier visits also judge a keyframe: up to this many kept views of keyframes that
+  /// left the window, the nearest within 0.5 m and 30 deg of it (a view is kept only where no
+  /// kept one lies within 0.1 m and 10 deg: they grow with the space explored). 0 = off.
+  int window_revisit_keyframes = 8;
   /// ... and a keyframe's held-back pixels get a second look once the keyframes this long after
   /// it are there (a standing person is often confirmed static only seconds later); what that
   /// unmasks goes to the backend then. <= window_after_s: no second look.
