@@ -29,7 +29,7 @@ run_asan() {
     -DDYNAMAP_FAST_PATHS=OFF >/dev/null
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_io_tests dynamap_eval_tests dynamap_tracking_tests dynamap_dynamic_tests \
-    dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests
+    dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests dynamap_loop_tests
   # detect_leaks: OpenCV/TBB/OpenVDB keep process-lifetime caches; leaks are checked too, with
   # the third-party ones listed in scripts/lsan.supp.
   # alloc_dealloc_mismatch=0: Debian's PCL is built as C++14, where Eigen gives PointCloud a
@@ -55,7 +55,7 @@ run_tsan() {
   export OMP_NUM_THREADS=1 OPENCV_FOR_THREADS_NUM=1
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_tracking_tests dynamap_mapping_tests dynamap_cli_tests dynamap_dynamic_tests \
-    dynamap_system_tests
+    dynamap_system_tests dynamap_loop_tests
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
   nice -n 19 ctest --test-dir "$dir" -L threaded -LE timing --output-on-failure -j"${TEST_JOBS:-2}" \
