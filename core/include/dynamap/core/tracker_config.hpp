@@ -89,7 +89,7 @@ struct TrackerConfig {
   double kf_reuse_distance = 0.5;
   /// ... unless its motion mask covered more than this share of the image more than the
   /// frame's does: the new view shows static scene the old one had masked.
-  double kf_reuse_max_masked_gain = 0.1;
+  double kf_reuse_max_masked_gain = 0.02;
   /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
   /// The keyframes of one pass give the map its views of movers from several times.
   double kf_reuse_min_age_s = 5.0;
