@@ -267,6 +267,7 @@ void System::finish() {
     std::exception_ptr drain_failed;
     std::thread drain([&] {
       try {
+        ScopedStageTimer timer(s.timings, "finish_mapping_drain");  // the queue, the last window
         s.mapper->drain();
       } catch (...) {
         drain_failed = std::current_exception();
@@ -285,6 +286,7 @@ void System::finish() {
     for (const auto& kf : s.tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
     s.mapper->applyPoseUpdates(final_poses);
   }
+  ScopedStageTimer timer(s.timings, "finish_mapping");  // after the final poses
   s.mapper->finish();
 }
 

@@ -74,8 +74,10 @@ struct SystemOptions {
 ///
 /// Per frame, track() runs the tracker (features, dynamic regions, pose, keyframe decision),
 /// hands a new keyframe to the mapping thread and forwards bundle-adjustment corrections.
-/// finish() runs the final bundle adjustment, gives the mapper the final keyframe poses and
-/// waits for it; exportMap() writes the backend's files.
+/// The mapper judges and integrates each keyframe about a second after its frame, so
+/// exportMapSnapshot() writes the map so far at any moment. finish() runs the final bundle
+/// adjustment, gives the mapper the final keyframe poses and waits for it; exportMap() writes
+/// the backend's files.
 ///
 /// Threading: a System is not thread-safe. Call every method from one thread (or serialise
 /// the calls); the bundle-adjustment, detector and mapping threads it owns are internal and
