@@ -65,6 +65,7 @@ void MappingWorker::push(KeyframePacketPtr kf) {
   }
   if (stopping_) return;
   queue_.push_back(std::move(kf));
+  ++pushed_;
   lock.unlock();
   not_empty_.notify_one();
 }
@@ -76,6 +77,7 @@ bool MappingWorker::tryPush(KeyframePacketPtr kf) {
     return false;
   }
   queue_.push_back(std::move(kf));
+  ++pushed_;
   lock.unlock();
   not_empty_.notify_one();
   return true;
@@ -84,7 +86,7 @@ bool MappingWorker::tryPush(KeyframePacketPtr kf) {
 void MappingWorker::applyPoseUpdates(const std::vector<PoseUpdate>& updates) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    pending_updates_.insert(pending_updates_.end(), updates.begin(), updates.end());
+    for (const auto& u : updates) pending_updates_.emplace_back(pushed_, u);
   }
   not_empty_.notify_one();
 }
@@ -100,21 +102,29 @@ void MappingWorker::run() {
     std::vector<PoseUpdate> updates;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      not_empty_.wait(lock,
-                      [this] { return stopping_ || !queue_.empty() || !pending_updates_.empty(); });
-      if (!queue_.empty()) {
+      // An update published after the n-th keyframe was queued is applied after that keyframe
+      // and before the next: the same order as the tracker's, whatever the threads' timing.
+      const auto due = [this] {
+        return !pending_updates_.empty() && pending_updates_.front().first <= taken_;
+      };
+      not_empty_.wait(lock, [&] { return stopping_ || !queue_.empty() || due(); });
+      while (due()) {
+        updates.push_back(pending_updates_.front().second);
+        pending_updates_.pop_front();
+      }
+      if (updates.empty() && !queue_.empty()) {
         kf = std::move(queue_.front());
         queue_.pop_front();
+        ++taken_;
       }
-      updates.swap(pending_updates_);
       if (!kf && updates.empty() && stopping_) break;
       busy_ = true;
     }
     not_full_.notify_all();
     {
       std::lock_guard<std::mutex> lock(backend_mutex_);
-      if (kf) advanceWindow(std::move(kf), false);
       for (const auto& u : updates) applyUpdateLocked(u);
+      if (kf) advanceWindow(std::move(kf), false);
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -354,7 +364,8 @@ void MappingWorker::finish() {
   std::vector<PoseUpdate> late;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    late.swap(pending_updates_);  // arrived after the thread's last round
+    for (const auto& u : pending_updates_) late.push_back(u.second);  // after the last round
+    pending_updates_.clear();
   }
   std::lock_guard<std::mutex> lock(backend_mutex_);
   for (const auto& u : late) applyUpdateLocked(u);

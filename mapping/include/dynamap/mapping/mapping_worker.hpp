@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "dynamap/core/frame.hpp"
@@ -154,13 +155,17 @@ class MappingWorker {
   int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
-  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, stopping_, busy_
+  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, pushed_, taken_, stopping_, busy_
   std::condition_variable not_empty_;
   std::condition_variable not_full_;
   std::condition_variable idle_;
   bool busy_ = false;  ///< the thread is processing what it took from the queue
   std::deque<KeyframePacketPtr> queue_;
-  std::vector<PoseUpdate> pending_updates_;
+  /// Pose updates with the number of keyframes queued before them: the thread applies each after
+  /// those keyframes and before the next, so the map does not depend on thread timing.
+  std::deque<std::pair<std::size_t, PoseUpdate>> pending_updates_;
+  std::size_t pushed_ = 0;  ///< keyframes queued so far
+  std::size_t taken_ = 0;   ///< keyframes the thread took so far
   bool stopping_ = false;
   bool finished_ = false;
   bool drained_ = false;   ///< guarded by backend_mutex_
