@@ -109,6 +109,11 @@ TEST(TrackerLoopClosure, DISABLED_RevisitRemovesDriftOffline) {
 }
 
 TEST(TrackerLoopClosure, OfflineRunsRepeat) {
+#ifdef DYNAMAP_INSTRUMENTED_BUILD
+  // Two whole runs take 4 minutes under TSan; repeatability is the Release suite's question, the
+  // threads' races are RealtimeCorrectionsLandConcurrently's.
+  GTEST_SKIP() << "checked in the Release build";
+#endif
   const LoopRun a = runLoop(true, true);
   const LoopRun b = runLoop(true, true);
   ASSERT_EQ(a.trajectory.size(), b.trajectory.size());
