@@ -216,10 +216,18 @@ void Pipeline::processFrame(std::size_t index, const FrameLoad& load, RunResult&
   if (tracked.is_keyframe) {
     keyframe_entry_[tracked.keyframe->id] = index;
     if (!gt_masks_dir_.empty() && !tracked.keyframe->dynamic_mask.empty())
-      tracker_masks_.push_back({index, tracked.keyframe->dynamic_mask.clone()});
+      tracker_masks_.emplace_back(index, tracked.keyframe->dynamic_mask);
     if (options_.debug_images) writeDebugImage(entry, frame, tracked);
   }
   mappedKeyframes(tracked.mapped);
+}
+
+Pipeline::KeptMask::KeptMask(std::size_t entry_index, const cv::Mat& mask) : entry(entry_index) {
+  if (!mask.empty()) cv::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+}
+
+cv::Mat Pipeline::KeptMask::decoded() const {
+  return png.empty() ? cv::Mat() : cv::imdecode(png, cv::IMREAD_UNCHANGED);
 }
 
 void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped) {
@@ -232,7 +240,7 @@ void Pipeline::mappedKeyframes(const std::vector<KeyframePacketPtr>& mapped) {
     keyframe_entry_.erase(it);
     cv::Mat mask = kf->dynamic_mask;
     if (mask.empty()) mask = cv::Mat::zeros(kf->bgr.size(), CV_8UC1);
-    if (!gt_masks_dir_.empty()) mapped_masks_[kf->id] = {index, mask};
+    if (!gt_masks_dir_.empty()) mapped_masks_[kf->id] = KeptMask(index, mask);
     if (options_.save_masks) writeKeyframeMask(entry, mask, kf->bgr.size());
   }
 }
@@ -242,7 +250,7 @@ void Pipeline::revisedKeyframeMasks() {
     const auto it = mapped_entry_.find(id);
     if (it == mapped_entry_.end()) continue;
     const SequenceEntry& entry = sequence_.entries()[it->second];
-    if (!gt_masks_dir_.empty()) mapped_masks_[id] = {it->second, mask};
+    if (!gt_masks_dir_.empty()) mapped_masks_[id] = KeptMask(it->second, mask);
     if (options_.save_masks) writeKeyframeMask(entry, mask, mask.size());
   }
 }
@@ -262,10 +270,10 @@ void Pipeline::scoreKeyframeMasks(RunResult& result) const {
     return scoreMask(mask, gt);
   };
   for (const KeptMask& kept : tracker_masks_) {
-    if (const auto s = score(kept.entry, kept.mask)) result.tracker_mask_scores.add(*s);
+    if (const auto s = score(kept.entry, kept.decoded())) result.tracker_mask_scores.add(*s);
   }
   for (const auto& [id, kept] : mapped_masks_) {
-    if (const auto s = score(kept.entry, kept.mask)) result.mask_scores.add(*s);
+    if (const auto s = score(kept.entry, kept.decoded())) result.mask_scores.add(*s);
   }
 }
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <cstdint>
 #include <vector>
 
 #include "dynamap/core/frame.hpp"
@@ -98,10 +99,14 @@ class Pipeline {
   std::unordered_map<std::uint64_t, std::size_t> keyframe_entry_;  ///< keyframe id -> entry
   std::map<std::uint64_t, std::size_t> mapped_entry_;              ///< mapped keyframe id -> entry
   /// With ground-truth masks: each keyframe's mask as the tracker made it (entry, mask), in
-  /// keyframe order, and as the map used it (by keyframe id).
+  /// keyframe order, and as the map used it (by keyframe id); kept PNG-encoded (a long run
+  /// keeps one per keyframe: 300 KB raw, a few KB encoded).
   struct KeptMask {
+    KeptMask() = default;
+    KeptMask(std::size_t entry_index, const cv::Mat& mask);
+    cv::Mat decoded() const;
     std::size_t entry = 0;
-    cv::Mat mask;
+    std::vector<std::uint8_t> png;
   };
   std::vector<KeptMask> tracker_masks_;
   std::map<std::uint64_t, KeptMask> mapped_masks_;
