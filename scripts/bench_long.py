@@ -9,10 +9,11 @@ ratios) and writes it to OUT/long.md. The long sequences are made under /tmp on 
 Standard library only (make_long.py needs Debian's numpy).
 """
 import argparse
-import json
 import os
 import subprocess
 import sys
+
+from bench_tables import load  # one reader of the run folders' JSON files
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -25,14 +26,6 @@ CASES = {
     "crowd": (f"{DATA}/dynamic/teddy_dyn_crowd_dev", 200, []),
     "bonn": (f"{DATA}/bonn/rgbd_bonn_crowd_400_499", 100, ["--config", "config/bonn.yaml"]),
 }
-
-
-def load(path):
-    try:
-        with open(path) as f:
-            return json.load(f)
-    except (OSError, ValueError):
-        return {}
 
 
 def long_sequence(name, passes):
