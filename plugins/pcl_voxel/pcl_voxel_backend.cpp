@@ -1,21 +1,26 @@
-// `pcl_voxel`: an incrementally voxel-filtered cloud. Each keyframe's points are added to a hash
-// map voxel key -> running centroid/colour (never re-filtering the whole map). For pose updates,
-// each keyframe also keeps its points reduced to voxel centroids (camera frame); a moved
-// keyframe marks the map dirty and export rebuilds the hash from those (cheap: reduced clouds).
-#include <unordered_map>
+// `pcl_voxel`: a voxel-filtered cloud that follows pose corrections. Each keyframe's points
+// are reduced to voxel centroids (grouped by world voxel at integration) and kept compactly in
+// its camera frame (keyframe_voxels.hpp); the map is those centroids placed by the keyframes'
+// current poses and merged by world voxel, at export. No whole-map structure lives between
+// exports: memory is the keyframes' reduced clouds, and a pose update costs nothing.
+#include <map>
+#include <optional>
 
 #include <pcl/filters/statistical_outlier_removal.h>
 
 #include "dynamap/mapping/backend_params.hpp"
+#include "dynamap/mapping/flat_index.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
 #include "dynamap/mapping/radix_sort.hpp"
+#include "keyframe_voxels.hpp"
 #include "pcl_cloud_io.hpp"
 #include "voxel_key.hpp"
 
 namespace dynamap {
 namespace {
 
-using VoxelMap = std::unordered_map<std::uint64_t, plugin::VoxelAccum>;
+/// Keyframe centroids are kept on a grid this many times finer than the map's voxels.
+constexpr float kCentroidGridPerVoxel = 16.0f;
 
 class PclVoxelBackend final : public MapBackend {
  public:
@@ -32,55 +37,45 @@ class PclVoxelBackend final : public MapBackend {
   void integrate(const KeyframeView& view) override {
     const Eigen::Isometry3f T = view.T_W_C.cast<float>();
     const auto& pts = *view.points_C;
-    // Sort the keyframe's points by world voxel: one hash access per distinct voxel, and the
-    // same runs give the keyframe's own reduced cloud (kept in the camera frame for pose updates).
+    // Sort the keyframe's points by world voxel: the runs are its reduced cloud.
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(pts.size());
-    std::vector<Eigen::Vector3f> p_W(pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      p_W[i] = T * pts[i];
-      keyed[i] = {plugin::voxelKey(p_W[i], inv_voxel_), static_cast<std::uint32_t>(i)};
+      keyed[i] = {plugin::voxelKey(T * pts[i], inv_voxel_), static_cast<std::uint32_t>(i)};
     }
     radixSortByKey(keyed, scratch_, [](const auto& k) { return k.first; });
-    Keyframe kf;
-    kf.T_W_C = view.T_W_C;
-    kf.T_integrated = view.T_W_C;
-    const Eigen::Isometry3f T_C_W = T.inverse();
+    std::vector<plugin::VoxelAccum> voxels_C;
     for (std::size_t b = 0; b < keyed.size();) {
       plugin::VoxelAccum run;
       std::size_t e = b;
       for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
-        run.add(p_W[keyed[e].second], (*view.colors)[keyed[e].second].data());
+        run.add(pts[keyed[e].second], (*view.colors)[keyed[e].second].data());
       }
-      plugin::VoxelAccum& dst = map_[keyed[b].first];
-      dst.sum += run.sum;
-      for (int k = 0; k < 3; ++k) dst.rgb_sum[k] += run.rgb_sum[k];
-      dst.count += run.count;
-      run.sum = (T_C_W * (run.sum / static_cast<float>(run.count))) * static_cast<float>(run.count);
-      kf.voxels.push_back(run);
+      voxels_C.push_back(run);
       b = e;
     }
-    keyframes_[view.id] = std::move(kf);
+    const float grid_m = static_cast<float>(voxel_size_m_) / kCentroidGridPerVoxel;
+    keyframes_.insert_or_assign(view.id, Keyframe{view.T_W_C, {voxels_C, grid_m}});
+    elements_.reset();
   }
 
   void updatePose(std::uint64_t keyframe_id, const Eigen::Isometry3d& T_W_C) override {
     auto it = keyframes_.find(keyframe_id);
     if (it == keyframes_.end()) return;
     it->second.T_W_C = T_W_C;
-    dirty_ = dirty_ || !it->second.T_W_C.isApprox(it->second.T_integrated, 1e-9);
+    elements_.reset();
   }
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kInPlace; }
   void reset() override {
-    map_.clear();
     keyframes_.clear();
-    dirty_ = false;
+    elements_.reset();
   }
 
   void exportMap(const std::string& dir) override {
-    if (dirty_) rebuild();
     pcl::PointCloud<pcl::PointXYZRGB>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZRGB>);
-    cloud->reserve(map_.size());
-    for (const auto& kv : map_) {
-      const plugin::VoxelAccum& a = kv.second;
+    const std::vector<plugin::VoxelAccum> voxels = mergedVoxels();
+    elements_ = voxels.size();
+    cloud->reserve(voxels.size());
+    for (const plugin::VoxelAccum& a : voxels) {
       if (a.count < static_cast<std::uint32_t>(min_points_)) continue;
       const std::array<std::uint8_t, 3> rgb = {static_cast<std::uint8_t>(a.rgb_sum[0] / a.count),
                                                static_cast<std::uint8_t>(a.rgb_sum[1] / a.count),
@@ -102,11 +97,9 @@ class PclVoxelBackend final : public MapBackend {
   MapStats stats() const override {
     MapStats s;
     s.keyframes = keyframes_.size();
-    s.elements = map_.size();
-    std::size_t kf_voxels = 0;
-    for (const auto& kv : keyframes_) kf_voxels += kv.second.voxels.size();
-    const std::size_t node = sizeof(plugin::VoxelAccum) + sizeof(std::uint64_t) + 2 * sizeof(void*);
-    s.memory_bytes = map_.size() * node + kf_voxels * sizeof(plugin::VoxelAccum);
+    if (!elements_) elements_ = distinctVoxels();
+    s.elements = *elements_;
+    for (const auto& kv : keyframes_) s.memory_bytes += kv.second.voxels.bytes();
     s.element_kind = "voxels";
     return s;
   }
@@ -114,24 +107,48 @@ class PclVoxelBackend final : public MapBackend {
  private:
   struct Keyframe {
     Eigen::Isometry3d T_W_C;
-    Eigen::Isometry3d T_integrated;
-    std::vector<plugin::VoxelAccum> voxels;  ///< camera frame
+    plugin::KeyframeVoxels voxels;
   };
 
-  void rebuild() {
-    map_.clear();
-    for (auto& kv : keyframes_) {
+  /// Calls f(world voxel key, centroid_W, rgb, count) for every keyframe voxel, keyframes in
+  /// id order.
+  template <typename F>
+  void forEachPlacedVoxel(F&& f) const {
+    for (const auto& kv : keyframes_) {
       const Eigen::Isometry3f T = kv.second.T_W_C.cast<float>();
-      for (const plugin::VoxelAccum& a : kv.second.voxels) {
-        const Eigen::Vector3f p_W = T * (a.sum / static_cast<float>(a.count));
-        plugin::VoxelAccum& dst = map_[plugin::voxelKey(p_W, inv_voxel_)];
-        dst.sum += p_W * static_cast<float>(a.count);
-        for (int k = 0; k < 3; ++k) dst.rgb_sum[k] += a.rgb_sum[k];
-        dst.count += a.count;
-      }
-      kv.second.T_integrated = kv.second.T_W_C;
+      kv.second.voxels.forEach([&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb,
+                                   std::uint32_t n) {
+        const Eigen::Vector3f p_W = T * p_C;
+        f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
+      });
     }
-    dirty_ = false;
+  }
+
+  std::size_t placedVoxelCount() const {
+    std::size_t n = 0;
+    for (const auto& kv : keyframes_) n += kv.second.voxels.size();
+    return n;
+  }
+
+  /// The map: every keyframe's voxels at its current pose, merged by world voxel (in the order
+  /// of their first keyframe).
+  std::vector<plugin::VoxelAccum> mergedVoxels() const {
+    FlatIndex index(placedVoxelCount() / 2);
+    std::vector<plugin::VoxelAccum> merged;
+    forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f& p_W,
+                           const std::uint8_t* rgb, std::uint32_t n) {
+      const auto slot = index.tryEmplace(key, static_cast<std::uint32_t>(merged.size()));
+      if (slot.second) merged.emplace_back();
+      merged[slot.first].add(p_W, rgb, n);
+    });
+    return merged;
+  }
+
+  std::size_t distinctVoxels() const {
+    FlatIndex index(placedVoxelCount() / 2);
+    forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*,
+                           std::uint32_t) { index.tryEmplace(key, 0); });
+    return index.size();
   }
 
   double voxel_size_m_ = 0.01;
@@ -139,10 +156,9 @@ class PclVoxelBackend final : public MapBackend {
   int min_points_ = 1;
   int sor_k_ = 0;
   double sor_stddev_ = 1.0;
-  VoxelMap map_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> scratch_;  ///< integrate()'s sort
-  std::unordered_map<std::uint64_t, Keyframe> keyframes_;
-  bool dirty_ = false;
+  std::map<std::uint64_t, Keyframe> keyframes_;
+  mutable std::optional<std::size_t> elements_;  ///< distinct voxels, until the map changes
 };
 
 }  // namespace

@@ -39,3 +39,7 @@ add_custom_target(dynamap_example_plugin DEPENDS ${example_so})
 add_dependencies(dynamap_mapping_tests dynamap_example_plugin)
 target_compile_definitions(dynamap_mapping_tests PRIVATE
   DYNAMAP_EXAMPLE_PLUGIN_DIR="${example_dir}")
+
+# The backends' own helpers under test (header-only: keyframe_voxels.hpp).
+target_include_directories(dynamap_mapping_tests PRIVATE ${PROJECT_SOURCE_DIR}/plugins/common
+                                                         ${PROJECT_SOURCE_DIR}/plugins/pcl_voxel)

@@ -1,0 +1,58 @@
+// The pcl_voxel backend's compact per-keyframe voxels (plugins/pcl_voxel/keyframe_voxels.hpp):
+// centroids, colours and counts come back within the grid's rounding.
+#include <gtest/gtest.h>
+
+#include "keyframe_voxels.hpp"
+
+namespace dynamap {
+namespace {
+
+plugin::VoxelAccum voxelOf(const Eigen::Vector3f& p, std::uint8_t grey, std::uint32_t n) {
+  plugin::VoxelAccum a;
+  const std::uint8_t rgb[3] = {grey, static_cast<std::uint8_t>(grey / 2), 7};
+  a.add(p, rgb, n);
+  return a;
+}
+
+struct Unpacked {
+  Eigen::Vector3f p;
+  std::array<std::uint8_t, 3> rgb;
+  std::uint32_t n;
+};
+
+std::vector<Unpacked> unpack(const plugin::KeyframeVoxels& v) {
+  std::vector<Unpacked> out;
+  v.forEach([&](const Eigen::Vector3f& p, const std::uint8_t* rgb, std::uint32_t n) {
+    out.push_back({p, {rgb[0], rgb[1], rgb[2]}, n});
+  });
+  return out;
+}
+
+TEST(KeyframeVoxels, CentroidsColoursAndCountsComeBackWithinTheGrid) {
+  const float grid = 0.01f / 16;
+  const std::vector<plugin::VoxelAccum> in = {voxelOf({0.1234f, -0.5f, 1.9876f}, 200, 3),
+                                              voxelOf({-2.0f, 1.5f, 4.25f}, 17, 70000)};
+  const plugin::KeyframeVoxels v(in, grid);
+  EXPECT_EQ(v.bytes(), 2 * sizeof(plugin::CompactVoxel));
+  const auto out = unpack(v);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_LE((out[0].p - Eigen::Vector3f(0.1234f, -0.5f, 1.9876f)).cwiseAbs().maxCoeff(),
+            grid / 2 + 1e-6f);
+  EXPECT_EQ(out[0].rgb, (std::array<std::uint8_t, 3>{200, 100, 7}));
+  EXPECT_EQ(out[0].n, 3u);
+  EXPECT_EQ(out[1].n, 65535u);  // saturated, not wrapped
+}
+
+TEST(KeyframeVoxels, FarPointsGetACoarserGridInsteadOfOverflowing) {
+  const float grid = 0.001f / 16;  // 1 mm voxels: int16 reaches only 2 m at this grid
+  const std::vector<plugin::VoxelAccum> in = {voxelOf({0.5f, 0.0f, 6.0f}, 1, 1),
+                                              voxelOf({0.0f, -0.25f, 1.0f}, 1, 1)};
+  const auto out = unpack(plugin::KeyframeVoxels(in, grid));
+  const float unit = 6.0f / 32000.0f;
+  EXPECT_NEAR(out[0].p.z(), 6.0f, unit);
+  EXPECT_NEAR(out[0].p.x(), 0.5f, unit);
+  EXPECT_NEAR(out[1].p.y(), -0.25f, unit);
+}
+
+}  // namespace
+}  // namespace dynamap
