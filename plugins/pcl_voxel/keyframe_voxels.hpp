@@ -2,7 +2,8 @@
 
 // One keyframe's points reduced to voxel centroids, kept compactly in its camera frame so the
 // map can follow later pose corrections: 12 bytes a voxel (int16 coordinates on a per-keyframe
-// grid, mean colour, point count) instead of 28 for float sums.
+// grid, mean colour, point count) instead of 28 for float sums; in RAM while the keyframe is
+// active, then in a spill file.
 
 #include <algorithm>
 #include <array>
@@ -13,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "voxel_key.hpp"
+#include "voxel_spill_file.hpp"
 
 namespace dynamap::plugin {
 
@@ -38,16 +40,30 @@ class KeyframeVoxels {
     for (const VoxelAccum& a : voxels_C) voxels_.push_back(compact(a));
   }
 
-  /// Calls f(centroid_C, rgb, count) for each voxel.
+  /// Calls f(centroid_C, rgb, count) for each voxel; `buffer` holds them if spilled.
   template <typename F>
-  void forEach(F&& f) const {
-    for (const CompactVoxel& v : voxels_) {
+  void forEach(std::vector<CompactVoxel>& buffer, F&& f) const {
+    const std::vector<CompactVoxel>* voxels = &voxels_;
+    if (spill_) {
+      spill_->read(span_, buffer);
+      voxels = &buffer;
+    }
+    for (const CompactVoxel& v : *voxels) {
       const Eigen::Vector3f p(v.p[0] * unit_m_, v.p[1] * unit_m_, v.p[2] * unit_m_);
       f(p, v.rgb.data(), static_cast<std::uint32_t>(v.count));
     }
   }
 
-  std::size_t size() const { return voxels_.size(); }
+  /// Moves the voxels out of RAM into `file` (which must outlive this).
+  void spill(SpillFile<CompactVoxel>& file) {
+    if (spill_) return;
+    span_ = file.append(voxels_);
+    spill_ = &file;
+    std::vector<CompactVoxel>().swap(voxels_);
+  }
+
+  std::size_t size() const { return spill_ ? span_.count : voxels_.size(); }
+  /// Bytes held in RAM.
   std::size_t bytes() const { return voxels_.capacity() * sizeof(CompactVoxel); }
 
  private:
@@ -64,6 +80,8 @@ class KeyframeVoxels {
 
   float unit_m_ = 0.001f;
   std::vector<CompactVoxel> voxels_;
+  SpillFile<CompactVoxel>* spill_ = nullptr;
+  SpillFile<CompactVoxel>::Span span_;
 };
 
 }  // namespace dynamap::plugin

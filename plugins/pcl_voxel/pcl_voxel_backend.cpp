@@ -2,8 +2,11 @@
 // are reduced to voxel centroids (grouped by world voxel at integration) and kept compactly in
 // its camera frame (keyframe_voxels.hpp); the map is those centroids placed by the keyframes'
 // current poses and merged by world voxel, at export. No whole-map structure lives between
-// exports: memory is the keyframes' reduced clouds, and a pose update costs nothing.
+// exports: memory is the keyframes' reduced clouds (the newest resident_keyframes in RAM, the
+// others in a temporary file), and a pose update costs nothing.
+#include <deque>
 #include <map>
+#include <memory>
 #include <optional>
 
 #include <pcl/filters/statistical_outlier_removal.h>
@@ -30,6 +33,7 @@ class PclVoxelBackend final : public MapBackend {
     min_points_ = reader.getInt("min_points_per_voxel", 1, 1, 1000000);
     sor_k_ = reader.getInt("sor_k", 0, 0, 1000);
     sor_stddev_ = reader.getDouble("sor_stddev", 1.0, 0.0, 100.0);
+    resident_keyframes_ = reader.getInt("resident_keyframes", 32, 0, 1000000);
     reader.finish();
     inv_voxel_ = static_cast<float>(1.0 / voxel_size_m_);
   }
@@ -56,6 +60,7 @@ class PclVoxelBackend final : public MapBackend {
     const float grid_m = static_cast<float>(voxel_size_m_) / kCentroidGridPerVoxel;
     keyframes_.insert_or_assign(view.id, Keyframe{view.T_W_C, {voxels_C, grid_m}});
     elements_.reset();
+    spillOldKeyframes(view.id);
   }
 
   void updatePose(std::uint64_t keyframe_id, const Eigen::Isometry3d& T_W_C) override {
@@ -67,6 +72,7 @@ class PclVoxelBackend final : public MapBackend {
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kInPlace; }
   void reset() override {
     keyframes_.clear();
+    resident_.clear();
     elements_.reset();
   }
 
@@ -110,13 +116,28 @@ class PclVoxelBackend final : public MapBackend {
     plugin::KeyframeVoxels voxels;
   };
 
+  /// Beyond the newest resident_keyframes integrated, the oldest keyframe's voxels go to the
+  /// spill file (0: all stay in RAM).
+  void spillOldKeyframes(std::uint64_t newest) {
+    if (resident_keyframes_ <= 0) return;
+    resident_.push_back(newest);
+    while (resident_.size() > static_cast<std::size_t>(resident_keyframes_)) {
+      const auto it = keyframes_.find(resident_.front());
+      resident_.pop_front();
+      if (it == keyframes_.end()) continue;
+      if (!spill_) spill_ = std::make_unique<plugin::SpillFile<plugin::CompactVoxel>>();
+      it->second.voxels.spill(*spill_);
+    }
+  }
+
   /// Calls f(world voxel key, centroid_W, rgb, count) for every keyframe voxel, keyframes in
   /// id order.
   template <typename F>
   void forEachPlacedVoxel(F&& f) const {
+    std::vector<plugin::CompactVoxel> buffer;
     for (const auto& kv : keyframes_) {
       const Eigen::Isometry3f T = kv.second.T_W_C.cast<float>();
-      kv.second.voxels.forEach([&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb,
+      kv.second.voxels.forEach(buffer, [&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb,
                                    std::uint32_t n) {
         const Eigen::Vector3f p_W = T * p_C;
         f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
@@ -157,7 +178,10 @@ class PclVoxelBackend final : public MapBackend {
   int sor_k_ = 0;
   double sor_stddev_ = 1.0;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> scratch_;  ///< integrate()'s sort
+  int resident_keyframes_ = 32;
+  std::unique_ptr<plugin::SpillFile<plugin::CompactVoxel>> spill_;  ///< made at the first spill
   std::map<std::uint64_t, Keyframe> keyframes_;
+  std::deque<std::uint64_t> resident_;  ///< keyframes in RAM, oldest first
   mutable std::optional<std::size_t> elements_;  ///< distinct voxels, until the map changes
 };
 

@@ -3,6 +3,7 @@
 // readers, and following pose updates.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -206,6 +207,33 @@ TEST_P(BackendContract, RejectsUnknownParameterNamingTheKey) {
     EXPECT_NE(std::string(e.what()).find("mapping.params." + GetParam() + ".no_such_key"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// pcl_voxel keeps the newest resident_keyframes in RAM and the others in a spill file: the map
+// it exports after pose updates is the same either way.
+TEST(PclVoxelSpill, SpilledKeyframesGiveTheSameMapAsResidentOnes) {
+  const auto registry = BackendRegistry::scan({pluginDir()});
+  const auto names = registry.names();
+  if (std::find(names.begin(), names.end(), "pcl_voxel") == names.end()) {
+    GTEST_SKIP() << "pcl_voxel not built";
+  }
+  const Eigen::Vector3d shift(0.3, 0.2, 0.15);
+  std::vector<PlyData> maps;
+  for (const char* resident : {"0", "1"}) {
+    BackendParams params = backendCase("pcl_voxel").params;
+    params["resident_keyframes"] = resident;
+    const fs::path dir = freshTempDir(std::string("spill_") + resident);
+    const MapStats stats =
+        buildSyntheticMap(registry.create("pcl_voxel", params), kFrames, true, shift, dir.string());
+    EXPECT_EQ(stats.keyframes, static_cast<std::size_t>(kFrames));
+    maps.push_back(readPly((dir / "cloud.ply").string()));
+  }
+  ASSERT_GT(maps[0].vertices.size(), 200u);
+  ASSERT_EQ(maps[0].vertices.size(), maps[1].vertices.size());
+  for (std::size_t i = 0; i < maps[0].vertices.size(); ++i) {
+    ASSERT_LE((maps[0].vertices[i] - maps[1].vertices[i]).norm(), 1e-6f) << "point " << i;
+    ASSERT_EQ(maps[0].colors[i], maps[1].colors[i]) << "point " << i;
   }
 }
 

@@ -22,7 +22,8 @@ struct Unpacked {
 
 std::vector<Unpacked> unpack(const plugin::KeyframeVoxels& v) {
   std::vector<Unpacked> out;
-  v.forEach([&](const Eigen::Vector3f& p, const std::uint8_t* rgb, std::uint32_t n) {
+  std::vector<plugin::CompactVoxel> buffer;
+  v.forEach(buffer, [&](const Eigen::Vector3f& p, const std::uint8_t* rgb, std::uint32_t n) {
     out.push_back({p, {rgb[0], rgb[1], rgb[2]}, n});
   });
   return out;
@@ -52,6 +53,28 @@ TEST(KeyframeVoxels, FarPointsGetACoarserGridInsteadOfOverflowing) {
   EXPECT_NEAR(out[0].p.z(), 6.0f, unit);
   EXPECT_NEAR(out[0].p.x(), 0.5f, unit);
   EXPECT_NEAR(out[1].p.y(), -0.25f, unit);
+}
+
+TEST(KeyframeVoxels, SpilledVoxelsReadBackTheSameAndLeaveRam) {
+  const std::vector<plugin::VoxelAccum> in = {voxelOf({0.1f, 0.2f, 0.3f}, 9, 4),
+                                              voxelOf({-1.0f, 0.5f, 2.5f}, 250, 1)};
+  plugin::KeyframeVoxels a(in, 0.01f / 16), b(in, 0.01f / 16);
+  const auto before = unpack(a);
+  plugin::SpillFile<plugin::CompactVoxel> file;
+  a.spill(file);
+  b.spill(file);  // a second span after the first
+  EXPECT_EQ(a.bytes(), 0u);
+  EXPECT_EQ(b.size(), 2u);
+  EXPECT_EQ(file.bytes(), static_cast<long long>(4 * sizeof(plugin::CompactVoxel)));
+  for (const auto* v : {&a, &b}) {
+    const auto after = unpack(*v);
+    ASSERT_EQ(after.size(), before.size());
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      EXPECT_EQ(after[i].p, before[i].p);
+      EXPECT_EQ(after[i].rgb, before[i].rgb);
+      EXPECT_EQ(after[i].n, before[i].n);
+    }
+  }
 }
 
 }  // namespace
