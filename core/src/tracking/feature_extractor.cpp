@@ -28,12 +28,22 @@ GridOrbExtractor::GridOrbExtractor(const TrackerConfig& config)
     : orb_(cv::ORB::create(config.orb_features, static_cast<float>(config.orb_scale_factor),
                            config.orb_levels, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31,
                            config.orb_fast_threshold)),
+      search_orb_(cv::ORB::create(config.kf_reuse_orb_features,
+                                  static_cast<float>(config.orb_scale_factor), config.orb_levels,
+                                  19, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                                  config.kf_reuse_orb_fast_threshold)),
       cell_px_(std::max(1, config.grid_cell_px)),
       fill_threshold_(config.orb_fast_threshold_min) {}
 
 OrbFeatures GridOrbExtractor::extractAll(const cv::Mat& gray, const cv::Mat& allowed) const {
   OrbFeatures out;
   if (!gray.empty()) orb_->detectAndCompute(gray, allowed, out.keypoints, out.descriptors);
+  return out;
+}
+
+OrbFeatures GridOrbExtractor::extractForSearch(const cv::Mat& gray, const cv::Mat& allowed) const {
+  OrbFeatures out;
+  if (!gray.empty()) search_orb_->detectAndCompute(gray, allowed, out.keypoints, out.descriptors);
   return out;
 }
 

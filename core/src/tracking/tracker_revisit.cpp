@@ -84,7 +84,7 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(const RgbdFrame& frame
     ScopedStageTimer orb_timer(timings_, "orb");
     cv::Mat allowed;
     if (!track_mask.empty()) allowed = track_mask != 255;
-    features = extractor_.extractAll(gray, allowed);
+    features = extractor_.extractForSearch(gray, allowed);
   }
   std::vector<double> depth(features.keypoints.size());
   for (std::size_t i = 0; i < features.keypoints.size(); ++i) {

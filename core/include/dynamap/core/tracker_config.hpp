@@ -93,6 +93,11 @@ struct TrackerConfig {
   /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
   /// The keyframes of one pass give the map its views of movers from several times.
   double kf_reuse_min_age_s = 5.0;
+  /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
+  /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
+  /// third of the landmarks in view (teddy x10: 144 keyframes; 3000 at 7: 96).
+  int kf_reuse_orb_features = 3000;
+  int kf_reuse_orb_fast_threshold = 7;
 
   // --- local bundle adjustment (own thread) ---
   bool bundle_adjustment = true;  ///< local BA on its own thread

@@ -28,12 +28,17 @@ class GridOrbExtractor {
                       const std::vector<cv::Point2f>& occupied) const;
   /// Every ORB keypoint of the pyramid (no grid): for relocalization by descriptor matching.
   OrbFeatures extractAll(const cv::Mat& gray, const cv::Mat& allowed) const;
+  /// More ORB keypoints, down to a lower FAST threshold (kf_reuse_orb_*), no grid: for finding
+  /// known landmarks again by projection. Their keypoints won grid cells, often with a weak
+  /// response, and are mostly missing from extractAll's strongest ones.
+  OrbFeatures extractForSearch(const cv::Mat& gray, const cv::Mat& allowed) const;
 
  private:
   void fillEmptyCells(const cv::Mat& gray, const cv::Mat& allowed, int cols, int rows,
                       const std::vector<char>& taken, OrbFeatures& out) const;
 
   cv::Ptr<cv::ORB> orb_;
+  cv::Ptr<cv::ORB> search_orb_;
   int cell_px_;
   int fill_threshold_;
 };
