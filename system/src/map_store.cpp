@@ -56,8 +56,8 @@ void writeLandmarks(Db& db, const std::vector<Landmark>& landmarks) {
 }
 
 void writeKeyframes(Db& db, const std::vector<MapKeyframe>& keyframes) {
-  auto stmt = db.prepare("INSERT INTO keyframes VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                         "keyframes");
+  auto stmt =
+      db.prepare("INSERT INTO keyframes VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", "keyframes");
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const MapKeyframe& kf = keyframes[k];
     sqlite3_stmt* s = stmt.get();
@@ -104,11 +104,12 @@ void writeMapStore(const std::string& path, const MapContents& contents,
   {
     Db db(tmp_path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
     db.exec("PRAGMA journal_mode=OFF; PRAGMA synchronous=OFF; BEGIN;");
-    db.exec("CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-            "CREATE TABLE landmarks (id INTEGER PRIMARY KEY, x REAL, y REAL, z REAL,"
-            " descriptor BLOB, bad INTEGER, keyframes INTEGER);"
-            "CREATE TABLE keyframes (id INTEGER PRIMARY KEY, timestamp_s REAL, tx REAL, ty REAL,"
-            " tz REAL, qx REAL, qy REAL, qz REAL, qw REAL, masked_share REAL, observations BLOB);");
+    db.exec(
+        "CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+        "CREATE TABLE landmarks (id INTEGER PRIMARY KEY, x REAL, y REAL, z REAL,"
+        " descriptor BLOB, bad INTEGER, keyframes INTEGER);"
+        "CREATE TABLE keyframes (id INTEGER PRIMARY KEY, timestamp_s REAL, tx REAL, ty REAL,"
+        " tz REAL, qx REAL, qy REAL, qz REAL, qw REAL, masked_share REAL, observations BLOB);");
     writeMeta(db, metaOf(contents, camera, backend));
     writeLandmarks(db, contents.landmarks);
     writeKeyframes(db, contents.keyframes);

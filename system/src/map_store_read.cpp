@@ -35,8 +35,10 @@ class Reader {
 
   std::vector<Landmark> landmarks() {
     std::vector<Landmark> out;
-    auto stmt = db_.prepare("SELECT id, x, y, z, descriptor, bad, keyframes FROM landmarks "
-                            "ORDER BY id", "table landmarks");
+    auto stmt = db_.prepare(
+        "SELECT id, x, y, z, descriptor, bad, keyframes FROM landmarks "
+        "ORDER BY id",
+        "table landmarks");
     sqlite3_stmt* s = stmt.get();
     while (db_.step(s, "table landmarks")) {
       const std::string row = "landmarks row " + std::to_string(out.size());
@@ -61,8 +63,10 @@ class Reader {
 
   std::vector<MapKeyframe> keyframes(std::size_t landmark_count) {
     std::vector<MapKeyframe> out;
-    auto stmt = db_.prepare("SELECT id, timestamp_s, tx, ty, tz, qx, qy, qz, qw, masked_share, "
-                            "observations FROM keyframes ORDER BY id", "table keyframes");
+    auto stmt = db_.prepare(
+        "SELECT id, timestamp_s, tx, ty, tz, qx, qy, qz, qw, masked_share, "
+        "observations FROM keyframes ORDER BY id",
+        "table keyframes");
     sqlite3_stmt* s = stmt.get();
     while (db_.step(s, "table keyframes")) {
       const std::string row = "keyframes row " + std::to_string(out.size());
@@ -136,7 +140,8 @@ double number(const std::map<std::string, std::string>& meta, const std::string&
   const std::string& text = required(meta, key, reader);
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v)) reader.bad("meta." + key, "'" + text + "' is not a number");
+  if (text.empty() || *end != '\0' || !std::isfinite(v))
+    reader.bad("meta." + key, "'" + text + "' is not a number");
   return v;
 }
 
@@ -155,14 +160,13 @@ void checkVersionAndCamera(const std::map<std::string, std::string>& meta,
                                           std::to_string(kMapFormatVersion));
   }
   const std::pair<const char*, double> expected[] = {
-      {"camera.fx", camera.fx}, {"camera.fy", camera.fy},
-      {"camera.cx", camera.cx}, {"camera.cy", camera.cy},
-      {"camera.width", camera.width}, {"camera.height", camera.height}};
+      {"camera.fx", camera.fx}, {"camera.fy", camera.fy},       {"camera.cx", camera.cx},
+      {"camera.cy", camera.cy}, {"camera.width", camera.width}, {"camera.height", camera.height}};
   for (const auto& [key, value] : expected) {
     const double saved = number(meta, key, reader);
     if (std::abs(saved - value) > 1e-6 * std::max(1.0, std::abs(value))) {
       reader.bad(std::string("meta.") + key, "the map was made with " + shortNumber(saved) +
-                                               ", this camera has " + shortNumber(value));
+                                                 ", this camera has " + shortNumber(value));
     }
   }
 }

@@ -73,7 +73,8 @@ TEST(MapStore, RoundTripKeepsEveryField) {
   ASSERT_EQ(read.landmarks.size(), want.landmarks.size());
   for (std::size_t i = 0; i < want.landmarks.size(); ++i) {
     EXPECT_EQ(read.landmarks[i].p_W, want.landmarks[i].p_W) << i;  // doubles stored exactly
-    EXPECT_EQ(cv::norm(read.landmarks[i].descriptor, want.landmarks[i].descriptor, cv::NORM_HAMMING), 0);
+    EXPECT_EQ(
+        cv::norm(read.landmarks[i].descriptor, want.landmarks[i].descriptor, cv::NORM_HAMMING), 0);
     EXPECT_EQ(read.landmarks[i].bad, want.landmarks[i].bad);
     EXPECT_EQ(read.landmarks[i].keyframes, want.landmarks[i].keyframes);
   }
@@ -112,7 +113,8 @@ TEST(MapStore, MissingRowsAreNamedByTable) {
   const std::string path = writeSample("map_store_rows");
   runSql(path, "DELETE FROM keyframes WHERE id = 3");
   const std::string error = errorOf([&] { readMapStore(path, PinholeCamera{}); });
-  EXPECT_NE(error.find(path + ": table keyframes: 3 rows, meta.keyframes says 4"), std::string::npos)
+  EXPECT_NE(error.find(path + ": table keyframes: 3 rows, meta.keyframes says 4"),
+            std::string::npos)
       << error;
 }
 
@@ -134,7 +136,8 @@ TEST(MapStore, OtherCameraIsRefusedByName) {
       << error;
   other = PinholeCamera{};
   other.width = 320;
-  EXPECT_NE(errorOf([&] { readMapStore(path, other); }).find("meta.camera.width"), std::string::npos);
+  EXPECT_NE(errorOf([&] { readMapStore(path, other); }).find("meta.camera.width"),
+            std::string::npos);
 }
 
 TEST(MapStore, RowsThatDoNotFitAreNamedByRowAndField) {
@@ -155,8 +158,9 @@ TEST(MapStore, RowsThatDoNotFitAreNamedByRowAndField) {
   EXPECT_NE(edited("UPDATE landmarks SET descriptor = x'0102' WHERE id = 5")
                 .find("landmarks row 5: field descriptor has 2 bytes"),
             std::string::npos);
-  EXPECT_NE(edited("UPDATE keyframes SET qw = 7 WHERE id = 2").find("keyframes row 2: field qx/qy/qz/qw"),
-            std::string::npos);
+  EXPECT_NE(
+      edited("UPDATE keyframes SET qw = 7 WHERE id = 2").find("keyframes row 2: field qx/qy/qz/qw"),
+      std::string::npos);
   EXPECT_NE(edited("DELETE FROM meta WHERE key = 'camera.cy'").find("meta.camera.cy: missing"),
             std::string::npos);
 }

@@ -38,8 +38,8 @@ struct RunOutcome {
 };
 
 /// Tracks the walk's frames in `order`; errors against run 1's world (camera of frame 0).
-RunOutcome runWalk(System& system, const test::SyntheticScene& scene,
-                   const std::vector<int>& order, double t0_s) {
+RunOutcome runWalk(System& system, const test::SyntheticScene& scene, const std::vector<int>& order,
+                   double t0_s) {
   RunOutcome out;
   const Eigen::Isometry3d T_scene_W = walkPose(0);
   for (std::size_t j = 0; j < order.size(); ++j) {
@@ -94,13 +94,13 @@ TEST(SavedMap, ReloadRelocalizesInTheSavedFrameAndExtendsTheMap) {
   while (first_posed < run2.statuses.size() && run2.statuses[first_posed] == FrameStatus::kLost) {
     ++first_posed;
   }
-  std::printf("run 1: %zu keyframes, %zu voxels, RMS %.2f mm; run 2: posed from frame %zu, "
-              "RMS %.2f mm, %zu new keyframes, %zu voxels\n",
-              run1.counts.keyframes, run1.counts.map_elements, 1e3 * rms(run1.errors_m),
-              first_posed, 1e3 * rms(run2.errors_m), run2.counts.keyframes,
-              run2.counts.map_elements);
+  std::printf(
+      "run 1: %zu keyframes, %zu voxels, RMS %.2f mm; run 2: posed from frame %zu, "
+      "RMS %.2f mm, %zu new keyframes, %zu voxels\n",
+      run1.counts.keyframes, run1.counts.map_elements, 1e3 * rms(run1.errors_m), first_posed,
+      1e3 * rms(run2.errors_m), run2.counts.keyframes, run2.counts.map_elements);
   EXPECT_EQ(run2.counts.loaded_keyframes, run1.counts.keyframes);
-  EXPECT_LE(first_posed, 2u);  // relocalized in the first frames
+  EXPECT_LE(first_posed, 2u);                // relocalized in the first frames
   EXPECT_EQ(run2.counts.lost, first_posed);  // and never lost after that
   // In run 1's frame without any alignment: as accurate as run 1 itself (< 1 cm RMS there).
   EXPECT_LT(rms(run2.errors_m), 0.01);

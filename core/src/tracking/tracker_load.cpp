@@ -32,7 +32,7 @@ void Tracker::Impl::loadMap(MapContents contents) {
 }
 
 RelocalizationResult Tracker::Impl::relocalizeOutside(const RgbdFrame& frame, const cv::Mat& gray,
-                                                     const cv::Mat& mask) {
+                                                      const cv::Mat& mask) {
   OrbFeatures features;
   {
     ScopedStageTimer timer(timings_, "orb");
@@ -47,9 +47,10 @@ RelocalizationResult Tracker::Impl::relocalizeOutside(const RgbdFrame& frame, co
   for (const PlaceCandidate& place : places) {
     const auto kf = static_cast<std::uint64_t>(place.keyframe);
     const Eigen::Isometry3d T_W_kf = map_.keyframePose(kf);
-    std::vector<std::uint64_t> around = map_.keyframesNear(
-        T_W_kf, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
-    if (std::find(around.begin(), around.end(), kf) == around.end()) around.insert(around.begin(), kf);
+    std::vector<std::uint64_t> around =
+        map_.keyframesNear(T_W_kf, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
+    if (std::find(around.begin(), around.end(), kf) == around.end())
+      around.insert(around.begin(), kf);
     RelocalizationResult reloc = relocalizer_.relocalizeAgainst(
         features, frame.depth_m, map_.landmarksOf(around), camera_, T_W_kf);
     if (reloc.ok) return reloc;
