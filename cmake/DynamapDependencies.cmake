@@ -3,6 +3,7 @@
 find_package(TBB CONFIG REQUIRED)
 find_package(Threads REQUIRED)
 find_package(ZLIB REQUIRED)  # tools/io: the 16-bit depth PNG decoder (libpng already brings it)
+find_package(SQLite3 REQUIRED)  # system/: the saved map's keyframe store (--save-map / --load-map)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d video calib3d dnn)
 find_package(Ceres REQUIRED)

@@ -11,6 +11,9 @@ _Pose = npt.NDArray[np.float64]  # shape (4, 4), camera-to-world
 class ConfigError(ValueError):
     """Unknown configuration key, bad value or unreadable file (message names file/line/key)."""
 
+class MapFileError(ValueError):
+    """A saved map that is missing, corrupt or mismatched (message names file and field)."""
+
 class TrackResult:
     """Outcome of System.track() for one frame."""
 
@@ -38,6 +41,7 @@ class System:
         self,
         config: Optional[str] = None,
         overrides: Optional[Mapping[str, Union[_Scalar, Sequence[_Scalar]]]] = None,
+        load_map: Optional[str] = None,
     ) -> None:
         """Raises ConfigError for an unknown key or bad value, RuntimeError for an unknown
         backend or missing detector files."""
@@ -56,6 +60,8 @@ class System:
         """TUM format, as `dynamap run` writes OUT/trajectory.txt."""
     def finish(self) -> None: ...
     def export_map(self, directory: str) -> None: ...
+    def save_map(self, directory: str) -> None:
+        """finish(), then what System(load_map=directory) needs to start in this map."""
     def export_map_snapshot(self, directory: str) -> None:
         """The map as it is now, during the run, without finishing."""
     @property

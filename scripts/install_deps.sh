@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libopencv-dev libeigen3-dev libceres-dev libpcl-dev libopenmpi-dev liboctomap-dev
   libopenvdb-dev libtbb-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev pybind11-dev zlib1g-dev
+  libcli11-dev nlohmann-json3-dev pybind11-dev zlib1g-dev libsqlite3-dev
   python3 python3-dev python3-numpy python3-onnx python3-opencv python3-pybind11 python3-pytest
 )
 

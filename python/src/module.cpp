@@ -10,6 +10,7 @@
 
 #include "dynamap/system.hpp"
 #include "dynamap/system/config_schema.hpp"
+#include "dynamap/system/map_store.hpp"
 #include "numpy_convert.hpp"
 
 namespace py = pybind11;
@@ -27,12 +28,15 @@ struct PyTrackResult {
 };
 
 std::unique_ptr<System> makeSystem(const std::optional<std::string>& config,
-                                   const std::optional<py::dict>& overrides) {
+                                   const std::optional<py::dict>& overrides,
+                                   const std::optional<std::string>& load_map) {
   const std::vector<std::string> sets =
       overrides ? dynamap::python::overrideStrings(*overrides) : std::vector<std::string>{};
   const std::string path = config.value_or("");
-  py::gil_scoped_release release;  // loads detector weights and plugins
-  return System::fromConfig(path, sets);
+  dynamap::SystemOptions options;
+  options.load_map_dir = load_map.value_or("");
+  py::gil_scoped_release release;  // loads detector weights, plugins and the saved map
+  return System::fromConfig(path, sets, std::move(options));
 }
 
 PyTrackResult track(System& system, const py::array& bgr, const py::array& depth,
@@ -78,6 +82,7 @@ PYBIND11_MODULE(dynamap, m) {
       "    system.export_map('out/map')\n";
 
   py::register_exception<dynamap::ConfigError>(m, "ConfigError", PyExc_ValueError);
+  py::register_exception<dynamap::MapFileError>(m, "MapFileError", PyExc_ValueError);
 
   py::class_<PyTrackResult>(m, "TrackResult", "Outcome of System.track() for one frame.")
       .def_readonly("timestamp_s", &PyTrackResult::timestamp_s, "The frame's timestamp (s).")
@@ -99,12 +104,16 @@ PYBIND11_MODULE(dynamap, m) {
                      "own bundle-adjustment, detector and mapping threads). track(), finish() "
                      "and export_map() release the GIL.")
       .def(py::init(&makeSystem), py::arg("config") = py::none(), py::arg("overrides") = py::none(),
-           "System(config=None, overrides=None)\n\n"
+           py::arg("load_map") = py::none(),
+           "System(config=None, overrides=None, load_map=None)\n\n"
            "config: path of a YAML configuration (as `dynamap run --config`); None = the "
            "defaults in code.\noverrides: {'section.key': value} applied after the file, as "
            "`--set section.key=value` (bool, int, float, str or a list of them).\n"
-           "Raises ConfigError (a ValueError) for an unknown key or a bad value, RuntimeError "
-           "for an unknown mapping backend or missing detector files.")
+           "load_map: a folder save_map() wrote: start in that map (relocalize in it, poses "
+           "in its frame, new keyframes extend it), as `dynamap run --load-map`.\n"
+           "Raises ConfigError (a ValueError) for an unknown key or a bad value, MapFileError "
+           "(a ValueError) for a missing, corrupt or mismatched saved map (names the file and "
+           "field), RuntimeError for an unknown mapping backend or missing detector files.")
       .def("track", &track, py::arg("bgr"), py::arg("depth"), py::arg("timestamp_s"),
            "track(bgr, depth, timestamp_s) -> TrackResult\n\n"
            "bgr: HxWx3 uint8 colour image in BGR order (as cv2.imread gives it).\n"
@@ -135,6 +144,11 @@ PYBIND11_MODULE(dynamap, m) {
       .def("export_map", &System::exportMap, py::arg("directory"),
            py::call_guard<py::gil_scoped_release>(),
            "export_map(directory): finish(), then writes the backend's map files there.")
+      .def("save_map", &System::saveMap, py::arg("directory"),
+           py::call_guard<py::gil_scoped_release>(),
+           "save_map(directory): finish(), then writes what a later run needs to start in this "
+           "map (map.sqlite: keyframes, landmarks, poses, camera, format version; map/: the "
+           "backend's files). Load it with System(..., load_map=directory).")
       .def("export_map_snapshot", &System::exportMapSnapshot, py::arg("directory"),
            py::call_guard<py::gil_scoped_release>(),
            "export_map_snapshot(directory): the map as it is now, during the run, without "
@@ -152,6 +166,7 @@ PYBIND11_MODULE(dynamap, m) {
             d["keyframes"] = c.keyframes;
             d["mapped_keyframes"] = c.mapped_keyframes;
             d["map_elements"] = c.map_elements;
+            d["loaded_keyframes"] = c.loaded_keyframes;
             return d;
           },
           "Frame and keyframe counts so far (dict).");

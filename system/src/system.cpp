@@ -11,6 +11,8 @@
 #include "dynamap/mapping/backend_registry.hpp"
 #include "dynamap/mapping/mapping_worker.hpp"
 #include "dynamap/mapping/mask_lookahead.hpp"
+#include "dynamap/mapping/ply_io.hpp"
+#include "dynamap/system/map_store.hpp"
 #include "frame_input.hpp"
 #include "plugin_paths.hpp"
 
@@ -26,6 +28,7 @@ struct System::Impl {
   std::unique_ptr<MappingWorker> mapper;
   FrameInput input;
   std::uint64_t next_keyframe_id = 0;
+  std::string backend_name;
   SystemCounts counts;
   std::vector<TimedPose> given_trajectory;  // given poses only
   bool finished = false;
@@ -37,6 +40,8 @@ struct System::Impl {
   int pending_seen = 0;
   std::vector<KeyframePacketPtr> last_mapped;  // released by finish()
 
+  /// SystemOptions::load_map_dir: the tracker's map, and the points for a point backend.
+  void loadMap(const std::string& dir);
   void pushKeyframe(KeyframePacketPtr kf);
   /// Adds what `frame`'s mask covers to the waiting keyframe's mask; hands it to the mapper
   /// once lookahead_frames frames have been seen.
@@ -44,6 +49,19 @@ struct System::Impl {
                  std::vector<KeyframePacketPtr>& mapped);
   void releasePending(std::vector<KeyframePacketPtr>& mapped);
 };
+
+void System::Impl::loadMap(const std::string& dir) {
+  ScopedStageTimer timer(timings, "map_load");
+  const std::filesystem::path folder(dir);
+  MapContents contents = readMapStore((folder / kMapStoreFile).string(), camera);
+  counts.loaded_keyframes = contents.keyframes.size();
+  const std::filesystem::path cloud = folder / "map" / "cloud.ply";
+  if (std::filesystem::exists(cloud)) {
+    const PlyData ply = readPly(cloud.string());
+    if (mapper->importPoints(ply.vertices, ply.colors)) counts.loaded_map_points = ply.vertices.size();
+  }
+  tracker->loadMap(std::move(contents));
+}
 
 void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
   if (!options.drop_keyframes_when_busy) {
@@ -124,6 +142,9 @@ System::System(const AppConfig& config, SystemOptions options) : impl_(std::make
       std::move(backend), s.camera, config.mapping.static_points, s.options.mapping_queue_capacity,
       s.timings, s.options.drop_keyframes_when_busy ? 0 : s.options.mapping_thread_nice);
   s.motion_filter = std::move(s.options.motion_filter);
+  if (s.options.given_poses && !s.options.load_map_dir.empty()) {
+    throw std::invalid_argument("System: load_map_dir needs tracking (not with given poses)");
+  }
   if (s.options.given_poses) return;
   if (!s.motion_filter) {
     s.motion_filter = makeMotionFilter(config.dynamic, s.camera, s.timings);
@@ -133,6 +154,8 @@ System::System(const AppConfig& config, SystemOptions options) : impl_(std::make
   }
   s.tracker = std::make_unique<Tracker>(s.camera, config.tracking, s.timings);
   s.tracker->setMotionFilter(s.motion_filter.get());
+  s.backend_name = config.mapping.backend;
+  if (!s.options.load_map_dir.empty()) s.loadMap(s.options.load_map_dir);
 }
 
 std::unique_ptr<System> System::fromConfig(const std::string& config_path,
@@ -305,6 +328,18 @@ void System::exportMap(const std::string& dir) {
   std::filesystem::create_directories(dir);
   ScopedStageTimer timer(impl_->timings, "map_export");
   impl_->mapper->exportMap(dir);
+}
+
+void System::saveMap(const std::string& dir) {
+  auto& s = *impl_;
+  if (!s.tracker) throw std::logic_error("System::saveMap: not with given poses");
+  finish();
+  ScopedStageTimer timer(s.timings, "map_save");
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path folder(dir);
+  writeMapStore((folder / kMapStoreFile).string(), s.tracker->mapContents(), s.camera,
+                s.backend_name);
+  s.mapper->exportMap((folder / "map").string());
 }
 
 void System::exportMapSnapshot(const std::string& dir) {

@@ -1,9 +1,11 @@
 // dynamap evaluate: ATE/RPE of an estimated trajectory against ground truth, as the TUM
 // RGB-D benchmark scripts compute them.
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -24,7 +26,44 @@ struct EvaluateArgs {
   double rpe_delta = 1.0;
   std::string rpe_unit = "s";
   std::string rpe_pairs_path;
+  std::string save_alignment_path;
+  std::string alignment_path;
 };
+
+constexpr const char* kAlignmentHeader =
+    "# dynamap evaluate alignment: p_gt = scale * R * p_est + t; scale r00 r01 r02 r10 r11 r12 "
+    "r20 r21 r22 tx ty tz\n";
+
+void writeAlignment(const std::string& path, const Alignment& a) {
+  std::ofstream out(path);
+  out << kAlignmentHeader << std::setprecision(17) << a.scale;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out << ' ' << a.R(r, c);
+  }
+  out << ' ' << a.t.x() << ' ' << a.t.y() << ' ' << a.t.z() << '\n';
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+/// What writeAlignment() wrote; EvaluationError naming the file otherwise.
+Alignment readAlignment(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw EvaluationError(path + ": cannot read the alignment");
+  std::string line;
+  while (std::getline(in, line) && (line.empty() || line[0] == '#')) {
+  }
+  std::istringstream fields(line);
+  Alignment a;
+  fields >> a.scale;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) fields >> a.R(r, c);
+  }
+  fields >> a.t.x() >> a.t.y() >> a.t.z();
+  const bool rotation = (a.R.transpose() * a.R - Eigen::Matrix3d::Identity()).norm() < 1e-6;
+  if (!fields || !std::isfinite(a.scale) || a.scale <= 0.0 || !a.t.allFinite() || !rotation) {
+    throw EvaluationError(path + ": not an alignment (13 numbers: scale > 0, a rotation, t)");
+  }
+  return a;
+}
 
 /// One line per RPE pair: the later pose's stamp, translation (m) and rotation (deg) error.
 void writeRpePairs(const std::string& path, const RpeResult& rpe) {
@@ -45,6 +84,7 @@ int runEvaluate(const EvaluateArgs& args) {
   options.alignment = args.align == "sim3" ? AlignmentKind::kSim3 : AlignmentKind::kSe3;
   options.rpe_delta = args.rpe_delta;
   options.rpe_unit = args.rpe_unit == "f" ? RpeDeltaUnit::kFrames : RpeDeltaUnit::kSeconds;
+  if (!args.alignment_path.empty()) options.given_alignment = readAlignment(args.alignment_path);
 
   const std::vector<TimedPose> gt = readTrajectory(args.gt_path);
   const std::vector<TimedPose> est = readTrajectory(args.est_path);
@@ -58,6 +98,9 @@ int runEvaluate(const EvaluateArgs& args) {
     writeTrajectoryPlot(args.plot_path, gt, evaluation.ate);
   }
   if (!args.rpe_pairs_path.empty()) writeRpePairs(args.rpe_pairs_path, evaluation.rpe);
+  if (!args.save_alignment_path.empty()) {
+    writeAlignment(args.save_alignment_path, evaluation.ate.alignment);
+  }
   if (args.json) {
     std::cout << evaluationToJson(evaluation) << "\n";
   } else {
@@ -90,6 +133,11 @@ void addEvaluateCommand(CLI::App& app, int* exit_code) {
       ->capture_default_str();
   cmd->add_option("--rpe-pairs", args->rpe_pairs_path,
                   "write every RPE pair (stamp, translation m, rotation deg) to this file");
+  cmd->add_option("--save-alignment", args->save_alignment_path,
+                  "write the ATE alignment used (p_gt = scale R p_est + t) to this file");
+  cmd->add_option("--alignment", args->alignment_path,
+                  "apply this alignment (a --save-alignment file, e.g. of the run whose saved map "
+                  "a --load-map run started in) instead of estimating one");
   cmd->callback([args, exit_code] { *exit_code = runEvaluate(*args); });
 }
 

@@ -86,6 +86,12 @@ void addRunCommand(CLI::App& app, int* exit_code) {
                   "map with this TUM trajectory instead of tracking (e.g. motion capture)");
   cmd->add_option("--masks", options->masks_dir,
                   "use DIR/<timestamp>.png masks (255 = dynamic) instead of computing them");
+  cmd->add_option("--save-map", options->save_map_dir,
+                  "write the map (keyframes, landmarks, poses, camera, the backend's map) to DIR "
+                  "for a later --load-map");
+  cmd->add_option("--load-map", options->load_map_dir,
+                  "start in the map a --save-map run wrote to DIR: relocalize in it, report poses "
+                  "in its frame, extend it");
   cmd->add_flag("--save-masks", options->save_masks, "write each keyframe's mask to OUT/masks/");
   cmd->add_flag("--debug-images", options->debug_images, "write debug pictures to OUT/debug/");
   cmd->add_flag("--quiet", options->quiet, "no progress line");

@@ -87,6 +87,7 @@ Pipeline::Pipeline(const RunOptions& options, const AppConfig& config, const Tum
     s.given_poses = std::make_unique<PoseLookup>(readTrajectory(options_.poses_file));
     system_options.given_poses = true;
   }
+  system_options.load_map_dir = options_.load_map_dir;
   s.system = std::make_unique<System>(config_, std::move(system_options));
 }
 
@@ -331,8 +332,10 @@ void Pipeline::finalize(RunResult& result) {
   result.counts.keyframes = counts.keyframes;
   result.counts.mapped_keyframes = counts.mapped_keyframes;
   result.counts.mapper_dropped = counts.mapper_dropped;
+  result.counts.loaded_keyframes = counts.loaded_keyframes;
   result.map_dir = (fs::path(options_.out_dir) / "map").string();
   system.exportMap(result.map_dir);
+  if (!options_.save_map_dir.empty()) system.saveMap(options_.save_map_dir);  // after the outputs
 }
 
 }  // namespace dynamap

@@ -13,6 +13,8 @@ struct RunOptions {
   std::string out_dir;
   std::string poses_file;  ///< map with these TUM poses instead of tracking
   std::string masks_dir;   ///< use DIR/<timestamp>.png masks instead of computing them
+  std::string save_map_dir;  ///< write what a later run needs to start in this map
+  std::string load_map_dir;  ///< start in the map saved here (System::saveMap())
   bool save_masks = false;
   bool debug_images = false;
   bool quiet = false;

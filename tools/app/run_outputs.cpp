@@ -68,15 +68,16 @@ std::string timingsJson(const RunResult& result, const TimingRecorder& timings, 
 
 void writeRunJson(const std::string& out_dir, const RunResult& result) {
   const RunCounts& c = result.counts;
-  const Json counts = {{"frames_read", c.frames_read},
-                       {"tracked", c.tracked},
-                       {"relocalized", c.relocalized},
-                       {"lost", c.lost},
-                       {"bad_frames", c.bad_frames},
-                       {"keyframes", c.keyframes},
-                       {"mapped_keyframes", c.mapped_keyframes},
-                       {"skipped_realtime", c.skipped_realtime},
-                       {"mapper_dropped", c.mapper_dropped}};
+  Json counts = {{"frames_read", c.frames_read},
+                 {"tracked", c.tracked},
+                 {"relocalized", c.relocalized},
+                 {"lost", c.lost},
+                 {"bad_frames", c.bad_frames},
+                 {"keyframes", c.keyframes},
+                 {"mapped_keyframes", c.mapped_keyframes},
+                 {"skipped_realtime", c.skipped_realtime},
+                 {"mapper_dropped", c.mapper_dropped}};
+  if (c.loaded_keyframes > 0) counts["loaded_keyframes"] = c.loaded_keyframes;  // --load-map
   Json root = {{"status", result.status},
                {"mode", result.mode},
                {"counts", counts},

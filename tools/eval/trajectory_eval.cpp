@@ -165,10 +165,11 @@ Alignment alignPoses(const std::vector<TimedPose>& gt_in, const std::vector<Time
 }
 
 AteResult computeAteOfPairs(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt,
-                            bool with_scale) {
+                            bool with_scale, const std::optional<Alignment>& given) {
   AteResult r;
-  r.with_scale = with_scale;
-  r.alignment = alignPositions(est, gt, with_scale);
+  r.with_scale = given ? given->scale != 1.0 : with_scale;
+  r.alignment = given ? *given : alignPositions(est, gt, with_scale);
+  r.alignment_given = given.has_value();
   r.pairs = static_cast<std::size_t>(est.cols());
   for (Eigen::Index k = 0; k < est.cols(); ++k) {
     const Eigen::Vector3d aligned = r.alignment.scale * r.alignment.R * est.col(k) + r.alignment.t;
@@ -203,7 +204,8 @@ AteResult computeAte(const std::vector<TimedPose>& gt_in, const std::vector<Time
     est_xyz.col(k) = est[i_est].T_W_C.translation();
     timestamps_s.push_back(gt[i_gt].timestamp_s);
   }
-  AteResult r = computeAteOfPairs(est_xyz, gt_xyz, options.alignment == AlignmentKind::kSim3);
+  AteResult r = computeAteOfPairs(est_xyz, gt_xyz, options.alignment == AlignmentKind::kSim3,
+                                  options.given_alignment);
   r.timestamps_s = std::move(timestamps_s);
   return r;
 }
@@ -275,6 +277,7 @@ std::string evaluationToJson(const TrajectoryEvaluation& evaluation) {
               {"std_m", a.error_m.std_dev}, {"min_m", a.error_m.min},
               {"max_m", a.error_m.max}};
   if (a.with_scale) ate["scale"] = a.alignment.scale;
+  if (a.alignment_given) ate["alignment"] = "given";
   const RpeResult& r = evaluation.rpe;
   const Json rpe = {{"pairs", r.pairs},
                     {"delta", r.delta},
@@ -290,7 +293,8 @@ std::string evaluationToJson(const TrajectoryEvaluation& evaluation) {
 std::string evaluationToTable(const TrajectoryEvaluation& evaluation) {
   const AteResult& a = evaluation.ate;
   const RpeResult& r = evaluation.rpe;
-  std::string out = "ATE (" + std::string(a.with_scale ? "sim3" : "se3") + " alignment, " +
+  const std::string kind = a.alignment_given ? "given" : (a.with_scale ? "sim3" : "se3");
+  std::string out = "ATE (" + kind + " alignment, " +
                     std::to_string(a.pairs) + " pairs)\n";
   out += formatRow("rmse", a.error_m.rmse, "m");
   out += formatRow("mean", a.error_m.mean, "m");

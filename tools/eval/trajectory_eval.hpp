@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -24,6 +25,12 @@ enum class RpeDeltaUnit { kSeconds, kFrames };
 const char* toString(AlignmentKind kind);  ///< "se3" | "sim3"
 const char* toString(RpeDeltaUnit unit);   ///< "s" | "f"
 
+/// p_gt ~= scale * R * p_est + t.
+struct Alignment {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  double scale = 1.0;
+};
 /// Options. Defaults are those of the TUM benchmark scripts
 /// (evaluate_ate.py; evaluate_rpe.py --fixed_delta --delta 1 --delta_unit s).
 struct TrajectoryEvalOptions {
@@ -31,6 +38,9 @@ struct TrajectoryEvalOptions {
   AlignmentKind alignment = AlignmentKind::kSe3;
   double rpe_delta = 1.0;
   RpeDeltaUnit rpe_unit = RpeDeltaUnit::kSeconds;
+  /// Applied as it is instead of the least-squares alignment (e.g. another run's, to judge a
+  /// run that started in that run's saved map in its frame); `alignment` is then unused.
+  std::optional<Alignment> given_alignment;
 };
 
 /// Summary of a list of errors (numpy semantics: median averages the two middle values,
@@ -46,12 +56,6 @@ struct ErrorStats {
 };
 ErrorStats computeErrorStats(const std::vector<double>& errors);
 
-/// p_gt ~= scale * R * p_est + t.
-struct Alignment {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  double scale = 1.0;
-};
 /// Horn/Umeyama least-squares alignment of `est` onto `gt` (3xN each, N >= 1) via the SVD of
 /// the cross-covariance of the centred sets, with the reflection fix. with_scale -> Sim(3).
 Alignment alignPositions(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt, bool with_scale);
@@ -61,6 +65,7 @@ struct AteResult {
   ErrorStats error_m;
   Alignment alignment;
   bool with_scale = false;
+  bool alignment_given = false;  ///< TrajectoryEvalOptions::given_alignment was applied
   // Per associated pair, sorted by ground-truth time:
   std::vector<double> timestamps_s;             ///< ground-truth stamps
   std::vector<Eigen::Vector3d> gt_positions_m;  ///< ground-truth positions
@@ -97,8 +102,9 @@ Alignment alignPoses(const std::vector<TimedPose>& gt, const std::vector<TimedPo
 /// ATE of position pairs already associated (column k of `est` with column k of `gt`, N >= 1):
 /// alignment, per-pair errors and their statistics; `timestamps_s` stays empty. computeAte is
 /// this after associating by time.
+/// `given`: that alignment instead of the least-squares one.
 AteResult computeAteOfPairs(const Eigen::Matrix3Xd& est, const Eigen::Matrix3Xd& gt,
-                            bool with_scale);
+                            bool with_scale, const std::optional<Alignment>& given = {});
 
 /// ATE as evaluate_ate.py. Throws EvaluationError when fewer than 2 pairs associate.
 AteResult computeAte(const std::vector<TimedPose>& gt, const std::vector<TimedPose>& est,

@@ -109,7 +109,7 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
     if (!any) continue;
     w.keyframe_ids.push_back(kf.id);
     w.poses.push_back(kf.T_W_C);
-    w.fixed.push_back(k < first_free ? 1 : 0);
+    w.fixed.push_back(k < first_free || kf.loaded ? 1 : 0);  // a loaded map stays put
   }
   return w;
 }
@@ -194,7 +194,7 @@ std::vector<std::uint64_t> LocalMap::keyframesNear(const Eigen::Isometry3d& T_W_
   std::vector<std::pair<double, std::uint64_t>> near;
   const double max_rotation_rad = max_rotation_deg * M_PI / 180.0;
   for (const auto& kf : keyframes_) {
-    if (kf.timestamp_s > latest_s) continue;
+    if (kf.timestamp_s > latest_s && !kf.loaded) continue;
     const Eigen::Isometry3d T_kf_C = kf.T_W_C.inverse() * T_W_C;
     const double distance =
         std::max(T_kf_C.translation().norm() / max_translation_m,
@@ -227,6 +227,18 @@ LandmarkCandidates LocalMap::landmarksOfLocked(const std::vector<std::uint64_t>&
     }
   }
   return out;
+}
+
+MapContents LocalMap::contents() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return MapContents{landmarks_, keyframes_};
+}
+
+void LocalMap::restore(MapContents contents) {
+  for (auto& kf : contents.keyframes) kf.loaded = true;
+  std::lock_guard<std::mutex> lock(mutex_);
+  landmarks_ = std::move(contents.landmarks);
+  keyframes_ = std::move(contents.keyframes);
 }
 
 std::size_t LocalMap::observationCount(std::uint64_t keyframe_id) const {

@@ -15,12 +15,6 @@ constexpr double kGuidedRadiiPx[] = {60.0, 160.0};
 constexpr float kGuidedRatio = 0.9f;
 constexpr int kRelocRansacIterations = 1000;
 
-struct Candidates {
-  std::vector<std::uint64_t> ids;
-  cv::Mat descriptors;
-  std::vector<Eigen::Vector3d> points;
-};
-
 /// For each query: best train index (or -1) under the ratio test, among trains allowed by `near`.
 template <typename Near>
 std::vector<int> bestMatches(const cv::Mat& dist, int max_hamming, float ratio, Near near) {
@@ -54,9 +48,17 @@ RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const 
                                              const LocalMap& map, const PinholeCamera& camera,
                                              const Eigen::Isometry3d& T_W_C_hint) const {
   if (features.keypoints.size() < 6) return {};
-  Candidates c;
+  LandmarkCandidates c;
   map.relocCandidates(config_.reloc_keyframes, c.ids, c.descriptors, c.points);
-  if (c.ids.size() < 6) return {};
+  return relocalizeAgainst(features, depth_m, c, camera, T_W_C_hint);
+}
+
+RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
+                                                    const cv::Mat& depth_m,
+                                                    const LandmarkCandidates& c,
+                                                    const PinholeCamera& camera,
+                                                    const Eigen::Isometry3d& T_W_C_hint) const {
+  if (features.keypoints.size() < 6 || c.ids.size() < 6) return {};
   cv::Mat dist;
   cv::batchDistance(features.descriptors, c.descriptors, dist, CV_32S, cv::noArray(),
                     cv::NORM_HAMMING);

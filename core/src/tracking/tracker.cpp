@@ -58,7 +58,9 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   MotionFilterOutput widened;
   const MotionFilterOutput filtered =
       removeMovers(frame, gray, matches, T_W_C_pred, widened, result);
-  if (!initialized_) {
+  if (!initialized_ && loaded_places_) {
+    relocalizeInLoadedMap(frame, gray, filtered, widened, result);
+  } else if (!initialized_) {
     startMap(frame, gray, filtered, widened, result);
   } else {
     Eigen::Isometry3d T_W_C = T_W_C_pred;
@@ -403,5 +405,7 @@ std::vector<FrameStatus> Tracker::frameStatuses() const { return impl_->frameSta
 std::vector<double> Tracker::badFrameTimestamps() const { return impl_->badFrameTimestamps(); }
 std::vector<KeyframeInfo> Tracker::keyframes() const { return impl_->map_.keyframes(); }
 TrackerStats Tracker::stats() const { return impl_->stats(); }
+MapContents Tracker::mapContents() const { return impl_->map_.contents(); }
+void Tracker::loadMap(MapContents contents) { impl_->loadMap(std::move(contents)); }
 
 }  // namespace dynamap

@@ -234,6 +234,7 @@ void Tracker::Impl::record(double timestamp_s, FrameStatus status, const Eigen::
   r.timestamp_s = timestamp_s;
   r.status = status;
   r.T_W_C = T_W_C;
+  r.unposed = loaded_places_ != nullptr;
   if (initialized_) {
     r.has_ref = true;
     r.ref_kf = ref_kf_;
@@ -283,6 +284,7 @@ std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory
   std::vector<std::pair<double, Eigen::Isometry3d>> out;
   out.reserve(records_.size());
   for (const auto& r : records_) {
+    if (r.unposed) continue;
     const Eigen::Isometry3d T_W_C = r.has_ref ? kfs.at(r.ref_kf).T_W_C * r.T_ref_C : r.T_W_C;
     out.emplace_back(r.timestamp_s, T_W_C);
   }
@@ -292,7 +294,9 @@ std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory
 std::vector<FrameStatus> Tracker::Impl::frameStatuses() const {
   std::vector<FrameStatus> out;
   out.reserve(records_.size());
-  for (const auto& r : records_) out.push_back(r.status);
+  for (const auto& r : records_) {
+    if (!r.unposed) out.push_back(r.status);
+  }
   return out;
 }
 

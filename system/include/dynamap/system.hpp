@@ -44,6 +44,10 @@ struct SystemCounts {
   std::size_t map_elements = 0;  ///< the backend's points, voxels or cells so far
 
   std::size_t mapper_dropped = 0;  ///< SystemOptions::drop_keyframes_when_busy only
+  /// From SystemOptions::load_map_dir: keyframes and points the run started with (`keyframes`
+  /// counts only this run's new ones).
+  std::size_t loaded_keyframes = 0;
+  std::size_t loaded_map_points = 0;
 };
 
 /// How a System is wired beyond the typed configuration.
@@ -64,6 +68,13 @@ struct SystemOptions {
   /// and detector theirs; what is left is drained beside the last bundle adjustment. Not applied
   /// with drop_keyframes_when_busy (a starved mapper would drop keyframes there).
   int mapping_thread_nice = 19;
+  /// Start in the map that saveMap() wrote into this folder (empty = a new map): the tracker
+  /// relocalizes in it within the first frames (lost until then), poses are in its frame and new
+  /// keyframes extend it; point backends (`points`, `pcl_voxel`) start with its points, the
+  /// volumetric ones with the new keyframes only. A missing, corrupt or mismatched map (other
+  /// camera, other format version) makes the constructor throw MapFileError naming the file
+  /// and field. Not with given_poses.
+  std::string load_map_dir;
   /// Where every stage records its timings (borrowed; must outlive the System). Null = the
   /// System keeps its own (timings()).
   TimingRecorder* timings = nullptr;
@@ -137,6 +148,12 @@ class System {
   std::unordered_map<std::uint64_t, cv::Mat> revisedMasks() const;
   /// finish(), then writes the backend's map files into `dir` (created if needed).
   void exportMap(const std::string& dir);
+  /// finish(), then writes what a later run needs into `dir` (created if needed; see
+  /// SystemOptions::load_map_dir): `map.sqlite` (format version, camera, keyframes with poses
+  /// and observations, landmarks with descriptors; dynamap/system/map_store.hpp) and the
+  /// backend's files in `map/`. Throws MapFileError (or MappingError) on I/O failure; what was
+  /// computed stays available (trajectory(), exportMap()). Not with given poses.
+  void saveMap(const std::string& dir);
   /// The map as it is now, during the run, without finishing: waits until the mapper has taken
   /// the keyframes handed to it so far, then writes the backend's files into `dir` (created if
   /// needed). The keyframes of the last mapping.window_after_s are not in it yet. After

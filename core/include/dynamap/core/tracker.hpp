@@ -10,6 +10,7 @@
 
 #include "dynamap/core/camera.hpp"
 #include "dynamap/core/frame.hpp"
+#include "dynamap/core/map_contents.hpp"
 #include "dynamap/core/motion_filter.hpp"
 #include "dynamap/core/timing.hpp"
 #include "dynamap/core/tracker_config.hpp"
@@ -99,6 +100,16 @@ class Tracker {
   std::vector<double> badFrameTimestamps() const;  ///< markBadFrame()'s, in call order
   std::vector<KeyframeInfo> keyframes() const;     ///< latest optimised poses
   TrackerStats stats() const;                      ///< thread-safe
+  /// The map (landmarks, keyframes and their observations) with the latest poses: the final
+  /// ones after finish(). What a saved map keeps.
+  MapContents mapContents() const;
+  /// Starts in a saved map instead of a new one; call before the first track(). Until a frame
+  /// relocalizes in it (every loaded keyframe ranked by place recognition, then PnP against the
+  /// landmarks around the best ones), frames are kLost and make no keyframe; from then on poses
+  /// are in the saved map's frame, its keyframes are held fixed and revisits reuse them. The
+  /// frames before the first relocalization have no pose: finalTrajectory() and
+  /// frameStatuses() leave them out (stats() counts them lost).
+  void loadMap(MapContents contents);
 
   class Impl;
 

@@ -9,34 +9,13 @@
 #include <opencv2/core.hpp>
 
 #include "dynamap/core/frame.hpp"
+#include "dynamap/core/map_contents.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
 
 namespace dynamap {
 
 struct LoopCorrection;  // loop_closer.hpp
-
-/// A 3D point in the world with the ORB descriptor of its first observation.
-struct Landmark {
-  Eigen::Vector3d p_W;
-  cv::Mat descriptor;  ///< 1 x 32 CV_8U
-  bool bad = false;    ///< seen on a moving object: never used again
-  int keyframes = 0;   ///< keyframes that observed it
-};
-
-struct KeyframeObservation {
-  std::uint64_t landmark_id = 0;
-  Eigen::Vector2d px;
-  double depth_m = 0.0;  ///< 0 = none
-};
-
-struct MapKeyframe {
-  std::uint64_t id = 0;
-  double timestamp_s = 0.0;
-  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
-  std::vector<KeyframeObservation> observations;
-  double masked_share = 0.0;  ///< share of its image under the motion mask when it was made
-};
 
 /// A copy of the sliding window handed to bundle adjustment (no lock held while solving).
 struct BaWindow {
@@ -104,6 +83,11 @@ class LocalMap {
   /// The good landmarks those keyframes observed, each once, in the keyframes' order.
   LandmarkCandidates landmarksOf(const std::vector<std::uint64_t>& keyframe_ids) const;
   std::size_t observationCount(std::uint64_t keyframe_id) const;
+  /// A copy of everything (a saved map's tracker part).
+  MapContents contents() const;
+  /// Replaces the contents with a saved map's, its keyframes marked loaded (fixed in bundle
+  /// adjustment, old enough for any revisit). Ids must be dense (MapContents).
+  void restore(MapContents contents);
   double maskedShare(std::uint64_t keyframe_id) const;
 
  private:

@@ -31,6 +31,11 @@ class Relocalizer {
   RelocalizationResult relocalize(const OrbFeatures& features, const cv::Mat& depth_m,
                                   const LocalMap& map, const PinholeCamera& camera,
                                   const Eigen::Isometry3d& T_W_C_hint) const;
+  /// The same against given candidates (e.g. the landmarks around the keyframes that place
+  /// recognition found), `T_W_C_hint` guiding the first search.
+  RelocalizationResult relocalizeAgainst(const OrbFeatures& features, const cv::Mat& depth_m,
+                                         const LandmarkCandidates& c, const PinholeCamera& camera,
+                                         const Eigen::Isometry3d& T_W_C_hint) const;
 
  private:
   /// match[q] = candidate index of query q or -1.

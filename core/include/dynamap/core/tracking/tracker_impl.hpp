@@ -13,6 +13,7 @@
 #include "dynamap/core/tracking/local_ba.hpp"
 #include "dynamap/core/tracking/local_map.hpp"
 #include "dynamap/core/tracking/loop_thread.hpp"
+#include "dynamap/core/tracking/place_recognition.hpp"
 #include "dynamap/core/tracking/pose_optimizer.hpp"
 #include "dynamap/core/tracking/relocalizer.hpp"
 
@@ -32,6 +33,9 @@ struct FrameRecord {
   std::uint64_t ref_kf = 0;
   Eigen::Isometry3d T_ref_C = Eigen::Isometry3d::Identity();  ///< used when has_ref
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();    ///< used otherwise
+  /// Lost before the first relocalization in a loaded map: no pose in its frame (left out of
+  /// the trajectory).
+  bool unposed = false;
 };
 
 /// Share of the image's pixels that `mask` (CV_8UC1, may be empty) sets.
@@ -48,6 +52,8 @@ class Tracker::Impl {
   std::vector<FrameStatus> frameStatuses() const;
   std::vector<double> badFrameTimestamps() const { return bad_frames_; }
   TrackerStats stats() const;
+  /// tracker_load.cpp: see Tracker::loadMap().
+  void loadMap(MapContents contents);
 
   MotionFilter* filter_ = nullptr;
   LocalMap map_;
@@ -99,6 +105,15 @@ class Tracker::Impl {
   bool priorPose(const RgbdFrame& frame, Eigen::Isometry3d& T_W_C);
   bool relocalize(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& dynamic_mask,
                   Eigen::Isometry3d& T_W_C, int& inliers);
+  /// tracker_load.cpp: the first pose in a loaded map (see Tracker::loadMap()); on success the
+  /// tracker is initialised with the best keyframe as its reference.
+  /// Place recognition over the loaded keyframes, then PnP around the best: features outside
+  /// `mask` (255 = keep away).
+  RelocalizationResult relocalizeOutside(const RgbdFrame& frame, const cv::Mat& gray,
+                                         const cv::Mat& mask);
+  void relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat& gray,
+                             const MotionFilterOutput& filtered, const MotionFilterOutput& widened,
+                             TrackingResult& result);
   /// `movers`: the frame's motion mask without held-back objects (kf_max_masked_share).
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                     const cv::Mat& movers) const;
@@ -176,6 +191,9 @@ class Tracker::Impl {
   /// of a keyframe with fewer points (reuseKeyframe()).
   double ref_min_tracks_ = 0.0;
 
+  /// A loaded map not yet relocalized in: its keyframes' static descriptors, for place
+  /// recognition (null otherwise).
+  std::unique_ptr<PlaceRecognizer> loaded_places_;
   int loop_generation_ = 0;  ///< the newest loop correction applied (LoopCorrection::generation)
 
   std::vector<FrameRecord> records_;
