@@ -1,6 +1,8 @@
 // Movers no detector knows (issue 50): synthetic rooms with a textured box pushed over the floor,
 // through Tracker + makeMotionFilter(mode both, no detector). Only geometry can find the box:
-// the dense check's regions, tracked as class-less objects (dynamic.mover_tracks).
+// the dense check's regions, tracked as class-less objects (dynamic.mover_tracks, against the
+// depth 12 frames back). Measured: without removal (mode off) the cabinet pulls the pose by 71 cm
+// and the panel by 75 cm; with it, under 0.3 cm, 0.84-0.89 of the box masked, 1-3 % of the rest.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -290,8 +290,10 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
   }
   if (!moverTracks() || view == nullptr || depth_m.empty()) return;
   const auto start = Clock::now();
+  std::vector<Detection> people = dets;  // and last frame's, also those carried undetected
+  people.insert(people.end(), prev_people_.begin(), prev_people_.end());
   const cv::Mat exclude =
-      notMovers(depth_m.size(), prev_kept_movers_, evidence.planes, dets, classes_);
+      notMovers(depth_m.size(), prev_kept_movers_, evidence.planes, people, classes_);
   const std::vector<Detection> movers =
       moverDetections(depth_m, evidence.T_W_C, evidence.K, *view, exclude,
                       seenThroughOptions(config_));
@@ -370,6 +372,12 @@ FusionResult DynamicMotionFilter::fuseRegions(const MotionFilterInput& input,
 void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const FusionResult& fused) {
   prev_mask_ = fused.mask;
   if (moverTracks()) prev_kept_movers_ = keptMovers(fused);
+  prev_people_.clear();
+  for (const auto& o : fused.objects) {
+    if (moverTracks() && classes_.isHighDynamic(o.detection.class_id) &&
+        o.detection.class_id != ClassTable::kMover)
+      prev_people_.push_back(o.detection);
+  }
   pending_ = DepthView();
   if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);
   ++filtered_;
