@@ -9,10 +9,10 @@
 #include <iostream>
 #include <limits>
 
+#include "../tracking/tracking_test_utils.hpp"
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "synthetic_scene.hpp"
-#include "../tracking/tracking_test_utils.hpp"
 
 namespace dynamap {
 namespace {
@@ -49,8 +49,7 @@ MoverRun run(const test::SyntheticScene& scene, int frames, int from, int to) {
     f.depth_m = r.depth_m;
     const TrackingResult res = tracker.track(f);
     const Eigen::Vector3d truth = (T_0.inverse() * T_W_C).translation();
-    out.max_pose_error_m =
-        std::max(out.max_pose_error_m, (res.T_W_C.translation() - truth).norm());
+    out.max_pose_error_m = std::max(out.max_pose_error_m, (res.T_W_C.translation() - truth).norm());
     const int box_px = cv::countNonZero(r.mask);
     if (i < from || i >= to || box_px < kMinBoxPx) continue;
     const cv::Mat mask =

@@ -22,7 +22,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr long kStartupFramesBack = 3;  ///< addMovers(): the view's age before there is an older one
+/// addMovers(): the view's age in the first frames, before there is an older one.
+constexpr long kStartupFramesBack = 3;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -294,9 +295,8 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
   people.insert(people.end(), prev_people_.begin(), prev_people_.end());
   const cv::Mat exclude =
       notMovers(depth_m.size(), prev_kept_movers_, evidence.planes, people, classes_);
-  const std::vector<Detection> movers =
-      moverDetections(depth_m, evidence.T_W_C, evidence.K, *view, exclude,
-                      seenThroughOptions(config_));
+  const std::vector<Detection> movers = moverDetections(depth_m, evidence.T_W_C, evidence.K, *view,
+                                                        exclude, seenThroughOptions(config_));
   dets.insert(dets.end(), movers.begin(), movers.end());
   record("movers", msSince(start));
 }

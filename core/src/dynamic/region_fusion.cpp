@@ -140,9 +140,9 @@ cv::Mat RegionFusion::depthCut(const Frame& f, const cv::Rect& box, ObjectDecisi
   // A mover's box is its seen-through region's: its surface is as deep as that region was grown
   // (dense_depth_range_m), not a person's depth band (the teddy beside a pushed chair).
   const double band = d.detection.class_id == ClassTable::kMover ? config_.dense_depth_range_m
-                                                                   : config_.depth_band_m;
-  cv::Mat region = objectPixels(depth_m, box, band, &d.depth_m, prior,
-                                f.evidence.planes, prior_only, max_depth);
+                                                                 : config_.depth_band_m;
+  cv::Mat region =
+      objectPixels(depth_m, box, band, &d.depth_m, prior, f.evidence.planes, prior_only, max_depth);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);

@@ -78,9 +78,8 @@ class DynamicMotionFilter : public MotionFilter {
   /// DynamicConfig::mover_tracks, in mode both.
   bool moverTracks() const;
   /// With moverTracks(): the regions the dense check's view saw through (moverDetections()),
-  /// outside last frame's kept movers, the planes and the people's boxes (this frame's and
-  /// last frame's, carried ones too), appended to `dets`
-  /// as class-less movers. Records "movers".
+  /// outside last frame's kept movers, the planes and the people's boxes (this frame's and last
+  /// frame's, carried ones too), appended to `dets` as class-less movers. Records "movers".
   void addMovers(const cv::Mat& depth_m, const FusionEvidence& evidence,
                  std::vector<Detection>& dets);
   /// Pixels on the large planes of the frame (DynamicConfig::support_planes), found outside the
@@ -126,8 +125,8 @@ class DynamicMotionFilter : public MotionFilter {
   TimingRecorder* timing_;
   TimingRecorder own_timing_;
   MotionDiagnostics diagnostics_;
-  RigidMotion motion_;  ///< last frame-to-frame camera motion (diagnostics)
-  cv::Mat prev_mask_;   ///< last frame's mask: its matches do not vote for the camera motion
+  RigidMotion motion_;        ///< last frame-to-frame camera motion (diagnostics)
+  cv::Mat prev_mask_;         ///< last frame's mask: its matches do not vote for the camera motion
   cv::Mat prev_kept_movers_;  ///< last frame's movers decided static (none is found there)
   std::vector<Detection> prev_people_;  ///< last frame's high-dynamic objects (no mover there)
   /// Recent frames with their final poses (DynamicConfig::dense_check_frames). The last frame
