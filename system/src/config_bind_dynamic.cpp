@@ -58,6 +58,8 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addInt("dynamic.dense_min_region_px", &c.dense_min_region_px, 1, 1000000);
   schema.addDouble("dynamic.dense_depth_range_m", &c.dense_depth_range_m, 0.001, 10.0);
   schema.addDouble("dynamic.dense_grow_m", &c.dense_grow_m, 0.0, 10.0);
+  schema.addBool("dynamic.mover_tracks", &c.mover_tracks);
+  schema.addInt("dynamic.mover_view_frames", &c.mover_view_frames, 0, 120);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);

@@ -8,6 +8,7 @@
 //   scene.addPlane(origin, edge_u, edge_v);             // rectangle origin + two orthogonal edges
 //   scene.addBox(center, half_size);                    // axis-aligned static box
 //   scene.addMovingBox(center0, half_size, velocity);   // centre(t) = center0 + velocity * t
+//   scene.addMovingBox(c0, h, v, /*stop_s=*/1.0);        // ... min(t, stop_s): then it stands
 //   auto f = scene.render(T_W_C, t_s);                  // f.bgr, f.depth_m, f.mask
 
 #include <algorithm>
@@ -56,10 +57,13 @@ class SyntheticScene {
   void addBox(const Eigen::Vector3d& center, const Eigen::Vector3d& half_size) {
     addBoxFaces(center, half_size, -1);
   }
-  /// Axis-aligned box translating with constant velocity (m/s); drawn into the mask.
+  /// Axis-aligned box translating with constant velocity (m/s) until stop_s, standing there
+  /// from then on; drawn into the mask.
   void addMovingBox(const Eigen::Vector3d& center0, const Eigen::Vector3d& half_size,
-                    const Eigen::Vector3d& velocity) {
+                    const Eigen::Vector3d& velocity,
+                    double stop_s = std::numeric_limits<double>::infinity()) {
     velocities_.push_back(velocity);
+    stops_s_.push_back(stop_s);
     addBoxFaces(center0, half_size, static_cast<int>(velocities_.size()) - 1);
   }
 
@@ -135,7 +139,10 @@ class SyntheticScene {
 
   void drawRect(const Rect& r, const Eigen::Isometry3d& T_C_W, double t_s, RenderedFrame& f) const {
     Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-    if (r.moving >= 0) shift = velocities_[static_cast<std::size_t>(r.moving)] * t_s;
+    if (r.moving >= 0) {
+      const auto k = static_cast<std::size_t>(r.moving);
+      shift = velocities_[k] * std::min(t_s, stops_s_[k]);
+    }
     const Eigen::Vector3d o = T_C_W * (r.origin + shift);
     const Eigen::Vector3d eu = T_C_W.linear() * r.edge_u;
     const Eigen::Vector3d ev = T_C_W.linear() * r.edge_v;
@@ -206,6 +213,7 @@ class SyntheticScene {
   cv::RNG rng_;
   std::vector<Rect> rects_;
   std::vector<Eigen::Vector3d> velocities_;
+  std::vector<double> stops_s_;
 };
 
 }  // namespace dynamap::test

@@ -72,8 +72,11 @@ TEST(Nms, LowDynamicClassesKeepTheHigherThreshold) {
 TEST(ClassTable, DefaultsAndOverrides) {
   DynamicConfig c;
   const ClassTable t(c);
-  EXPECT_EQ(t.size(), 80u);
+  EXPECT_EQ(t.size(), 81u);  // COCO's 80 and the class-less mover
   EXPECT_EQ(t.name(0), "person");
+  EXPECT_EQ(t.name(ClassTable::kMover), "mover");
+  EXPECT_TRUE(t.isHighDynamic(ClassTable::kMover));
+  EXPECT_EQ(t.scoreThresholds().size(), 80u);  // the detector's classes only
   EXPECT_TRUE(t.isHighDynamic(ClassTable::classIndex("dog")));
   EXPECT_FALSE(t.isHighDynamic(ClassTable::classIndex("teddy bear")));
   EXPECT_DOUBLE_EQ(t.weight(0), 1.0);

@@ -80,10 +80,13 @@ ClassTable::ClassTable(const DynamicConfig& config) {
     if (id < 0) throw std::invalid_argument("dynamic.class_weights: unknown class '" + name + "'");
     weights_[id] = parseWeight(name, text);
   }
+  weights_.push_back(config.high_dynamic_weight);  // kMover; the detector never reports it
+  high_dynamic_.push_back(true);
 }
 
 const std::string& ClassTable::name(int class_id) const {
-  static const std::string kUnknown = "unknown";
+  static const std::string kUnknown = "unknown", kMoverName = "mover";
+  if (class_id == kMover) return kMoverName;
   if (class_id < 0 || class_id >= static_cast<int>(weights_.size())) return kUnknown;
   return cocoNames()[class_id];
 }

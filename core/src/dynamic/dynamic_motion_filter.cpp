@@ -1,6 +1,7 @@
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
 
 #include "dynamap/core/dynamic/detector_worker.hpp"
+#include "dynamap/core/dynamic/mover_regions.hpp"
 #include "dynamap/core/dynamic/support_planes.hpp"
 
 #include <algorithm>
@@ -20,6 +21,9 @@ namespace dynamap {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// addMovers(): the view's age in the first frames, before there is an older one.
+constexpr long kStartupFramesBack = 3;
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -78,6 +82,14 @@ MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
   return out;
 }
 
+SeenThroughOptions seenThroughOptions(const DynamicConfig& c) {
+  SeenThroughOptions o;
+  o.min_region_px = c.dense_min_region_px;
+  o.depth_range_m = c.dense_depth_range_m;
+  o.grow_m = c.dense_grow_m;
+  return o;
+}
+
 }  // namespace
 
 DetectorOptions detectorOptions(const DynamicConfig& c) {
@@ -106,7 +118,7 @@ DynamicMotionFilter::DynamicMotionFilter(const DynamicConfig& config, const Pinh
       classes_(config),
       fusion_(config, classes_),
       timing_(timing),
-      depth_history_(2 * config.dense_check_frames) {
+      depth_history_(std::max(2 * config.dense_check_frames, config.mover_view_frames)) {
   if (mode_ != FusionMode::kGeometry && config.detector != "none") {
     worker_ = std::make_unique<DetectorWorker>(
         makeObjectDetector(detectorOptions(config), classes_), config.detector_threads,
@@ -247,10 +259,7 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
                                          FusionResult& fused) {
   const DepthView* view = evidence.view;  // the same earlier view fusion's clusters were held to
   if (view == nullptr || depth_m.empty()) return;
-  SeenThroughOptions o;
-  o.min_region_px = config_.dense_min_region_px;
-  o.depth_range_m = config_.dense_depth_range_m;
-  o.grow_m = config_.dense_grow_m;
+  const SeenThroughOptions o = seenThroughOptions(config_);
   // Objects already decided (moving or kept) are fusion's: a kept person is not re-judged here.
   cv::Mat moved = seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
                                      fused.mask | fused.static_objects, o, &fused.seen_through);
@@ -262,6 +271,34 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   fused.mask |= moved;
   if (!fused.unconfirmed.empty()) fused.unconfirmed.setTo(0, moved);
   if (!fused.held.empty()) fused.held.setTo(0, moved);
+}
+
+bool DynamicMotionFilter::moverTracks() const {
+  return config_.mover_tracks && mode_ == FusionMode::kBoth;
+}
+
+void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence& evidence,
+                                    std::vector<Detection>& dets) {
+  // The view mover_view_frames back (an older one: a slow mover has moved farther, a fast one
+  // has left more of its old place), else dense_check_frames back. The first frames have no view
+  // that old: one kStartupFramesBack back finds a mover in view from the first frame before it
+  // has made the map.
+  const DepthView* view = nullptr;
+  for (const long back : {static_cast<long>(config_.mover_view_frames),
+                          static_cast<long>(config_.dense_check_frames), kStartupFramesBack}) {
+    if (view == nullptr && back > 0 && evidence.has_pose)
+      view = depth_history_.newestUpTo(filtered_ - back);
+  }
+  if (!moverTracks() || view == nullptr || depth_m.empty()) return;
+  const auto start = Clock::now();
+  std::vector<Detection> people = dets;  // and last frame's, also those carried undetected
+  people.insert(people.end(), prev_people_.begin(), prev_people_.end());
+  const cv::Mat exclude =
+      notMovers(depth_m.size(), prev_kept_movers_, evidence.planes, people, classes_);
+  const std::vector<Detection> movers = moverDetections(depth_m, evidence.T_W_C, evidence.K, *view,
+                                                        exclude, seenThroughOptions(config_));
+  dets.insert(dets.end(), movers.begin(), movers.end());
+  record("movers", msSince(start));
 }
 
 cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
@@ -323,17 +360,24 @@ FusionResult DynamicMotionFilter::fuseRegions(const MotionFilterInput& input,
     const cv::Size size = input.cur_gray != nullptr ? input.cur_gray->size() : cv::Size(640, 480);
     depth = cv::Mat::zeros(size, CV_32FC1);
   }
-  gatherEvidence(input, m, epi, evidence);
   FusionResult fused = fusion_.fuse(mode_, depth, m.cur_px, epi.is_dynamic, dets, evidence);
   record("fusion", msSince(start));
   start = Clock::now();
+  // With mover tracks too: what they do not hold (people's parts in their boxes) as before.
   if (evidence.has_pose && mode_ != FusionMode::kDetector) addSeenThrough(depth_m, evidence, fused);
   record("dense_check", msSince(start));
   return fused;
 }
 
-void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const cv::Mat& mask) {
-  prev_mask_ = mask;
+void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const FusionResult& fused) {
+  prev_mask_ = fused.mask;
+  if (moverTracks()) prev_kept_movers_ = keptMovers(fused);
+  prev_people_.clear();
+  for (const auto& o : fused.objects) {
+    if (moverTracks() && classes_.isHighDynamic(o.detection.class_id) &&
+        o.detection.class_id != ClassTable::kMover)
+      prev_people_.push_back(o.detection);
+  }
   pending_ = DepthView();
   if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);
   ++filtered_;
@@ -363,9 +407,11 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   FusionEvidence evidence;
   const EpipolarResult epi = flagMovingPoints(input, m, depth_m, dets, &evidence.background_fit);
   evidence.planes = supportPlanePixels(depth_m, dets);  // records its own time
+  gatherEvidence(input, m, epi, evidence);
+  addMovers(depth_m, evidence, dets);  // records "movers"
   FusionResult fused = fuseRegions(input, m, depth_m, dets, epi, evidence);
   MotionFilterOutput out = filterOutput(m.cur_px, epi.is_dynamic, fused);
-  endFrame(depth_m, fused.mask);
+  endFrame(depth_m, fused);
   keepDiagnostics(m, epi, out, std::move(dets), std::move(fused));
   return out;
 }

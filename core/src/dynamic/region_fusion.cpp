@@ -104,6 +104,8 @@ struct RegionFusion::Frame {
   cv::Mat certain;    ///< moving pixels with evidence of their own
   cv::Mat evidenced;  ///< pixels of objects masked for motion
   cv::Mat claimed;    ///< pixels of detected objects (clusters do not grow into them)
+  cv::Mat movers;     ///< pixels of moving movers (ClassTable::kMover): geometry saw them move
+  cv::Mat people;     ///< pixels of detected high-dynamic objects (no mover takes them)
 };
 
 RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classes)
@@ -135,8 +137,12 @@ cv::Mat RegionFusion::depthCut(const Frame& f, const cv::Rect& box, ObjectDecisi
       d.detection.class_id == kPerson && config_.person_max_height_m > 0.0 && fy > 0.0
           ? config_.person_max_height_m * fy / box.height
           : 0.0;
-  cv::Mat region = objectPixels(depth_m, box, config_.depth_band_m, &d.depth_m, prior,
-                                f.evidence.planes, prior_only, max_depth);
+  // A mover's box is its seen-through region's: its surface is as deep as that region was grown
+  // (dense_depth_range_m), not a person's depth band (the teddy beside a pushed chair).
+  const double band = d.detection.class_id == ClassTable::kMover ? config_.dense_depth_range_m
+                                                                 : config_.depth_band_m;
+  cv::Mat region =
+      objectPixels(depth_m, box, band, &d.depth_m, prior, f.evidence.planes, prior_only, max_depth);
   if (region.empty()) {
     region = cv::Mat::zeros(depth_m.size(), CV_8UC1);
     region(box).setTo(255);
@@ -170,6 +176,10 @@ cv::Mat RegionFusion::detectedRegion(const Frame& f, const cv::Rect& box, Object
 
 void RegionFusion::applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                                FusionResult& result) const {
+  // A person's pixels are his track's to judge: a mover's box beside him does not take them.
+  const bool mover = d.detection.class_id == ClassTable::kMover;
+  if (mover) region(box).setTo(0, f.people(box));
+  if (!mover && classes_.isHighDynamic(d.detection.class_id)) f.people(box) |= region(box);
   f.claimed(box) |= region(box);
   if (d.moving && f.mode == FusionMode::kBoth) {
     carveStatic(region, box, f.points, f.dyn, f.evidence.proven_static,
@@ -182,6 +192,7 @@ void RegionFusion::applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, con
     roi |= in_box;
   };
   add(d.moving ? result.mask : result.static_objects);
+  if (d.moving && mover) add(f.movers);
   if (d.moving) add(d.unconfirmed ? result.unconfirmed : f.certain);
   if (d.moving) add(d.motion_now || f.mode != FusionMode::kBoth ? f.evidenced : result.held);
   if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) add(f.confirmed);
@@ -258,6 +269,11 @@ void RegionFusion::finishMasks(Frame& f, FusionResult& result) const {
   // What has proven static over time is not another object's: a walker's box that covers the
   // teddy (or a standing person) must not take its depth cut.
   if (cv::countNonZero(f.confirmed) > 0) result.mask.setTo(0, f.confirmed);
+  // ... unless the depth saw it move: a chair the detector knows, confirmed still, is pushed (a
+  // person's pixels stay his own track's, also one carried after the movers were decided).
+  cv::Mat pushed = f.movers.clone();
+  pushed.setTo(0, f.people);
+  result.mask |= pushed;
   if (f.mode != FusionMode::kDetector && f.evidence.flags_valid) {
     cv::Mat grown = cv::Mat::zeros(f.depth_m.size(), CV_8UC1);
     result.clusters =
@@ -285,7 +301,8 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const std::vector<Detection>& all_detections,
                                 const FusionEvidence& evidence) {
   const auto zeros = [&depth_m] { return cv::Mat(cv::Mat::zeros(depth_m.size(), CV_8UC1)); };
-  Frame f{mode, depth_m, points, dyn, evidence, zeros(), zeros(), zeros(), zeros()};
+  Frame f{mode,    depth_m, points,  dyn,     evidence, zeros(),
+          zeros(), zeros(), zeros(), zeros(), zeros()};
   FusionResult result = emptyResult(depth_m.size());
   std::vector<ObjectTrack> next;
   if (mode != FusionMode::kGeometry) {

@@ -118,6 +118,15 @@ struct DynamicConfig {
   int dense_min_region_px = 800;
   double dense_depth_range_m = 0.15;
   double dense_grow_m = 0.5;
+  /// The dense check's regions become class-less objects ("mover", ClassTable::kMover) that
+  /// fusion tracks as it tracks people (needs mode both): a pushed box stays masked between the
+  /// frames the check finds it in, and is kept once it has stood still for static_confirm_frames
+  /// (false: each frame's regions are masked in that frame only). Off: on, one metric of the
+  /// people sequences falls just outside its band (BENCHMARKS.md, issue 50).
+  bool mover_tracks = false;
+  /// Movers are found against the depth this many frames back (0 = dense_check_frames). 12
+  /// finds far more of a pushed chair or box (BENCHMARKS.md).
+  int mover_view_frames = 0;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   /// Such a carried box at the image border whose centre shows depth, but none within 0.5 m of

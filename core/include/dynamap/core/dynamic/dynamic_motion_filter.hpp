@@ -75,6 +75,13 @@ class DynamicMotionFilter : public MotionFilter {
   /// The dense check (DynamicConfig::dense_check_frames): what the frame that many frames back
   /// saw through, outside fusion's objects, is added to the mask.
   void addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence, FusionResult& fused);
+  /// DynamicConfig::mover_tracks, in mode both.
+  bool moverTracks() const;
+  /// With moverTracks(): the regions the dense check's view saw through (moverDetections()),
+  /// outside last frame's kept movers, the planes and the people's boxes (this frame's and last
+  /// frame's, carried ones too), appended to `dets` as class-less movers. Records "movers".
+  void addMovers(const cv::Mat& depth_m, const FusionEvidence& evidence,
+                 std::vector<Detection>& dets);
   /// Pixels on the large planes of the frame (DynamicConfig::support_planes), found outside the
   /// detections and the last mask; empty when off or without depth.
   cv::Mat supportPlanePixels(const cv::Mat& depth_m, const std::vector<Detection>& dets);
@@ -95,8 +102,8 @@ class DynamicMotionFilter : public MotionFilter {
   FusionResult fuseRegions(const MotionFilterInput& input, const FeatureMatches& m,
                            const cv::Mat& depth_m, const std::vector<Detection>& dets,
                            const EpipolarResult& epi, FusionEvidence& evidence);
-  /// What the next frame needs of this one: its mask and (dense check) its depth.
-  void endFrame(const cv::Mat& depth_m, const cv::Mat& mask);
+  /// What the next frame needs of this one: its masks and (dense check) its depth.
+  void endFrame(const cv::Mat& depth_m, const FusionResult& fused);
   void keepDiagnostics(const FeatureMatches& m, const EpipolarResult& epi,
                        const MotionFilterOutput& out, std::vector<Detection> dets,
                        FusionResult fused);
@@ -118,8 +125,10 @@ class DynamicMotionFilter : public MotionFilter {
   TimingRecorder* timing_;
   TimingRecorder own_timing_;
   MotionDiagnostics diagnostics_;
-  RigidMotion motion_;  ///< last frame-to-frame camera motion (diagnostics)
-  cv::Mat prev_mask_;   ///< last frame's mask: its matches do not vote for the camera motion
+  RigidMotion motion_;        ///< last frame-to-frame camera motion (diagnostics)
+  cv::Mat prev_mask_;         ///< last frame's mask: its matches do not vote for the camera motion
+  cv::Mat prev_kept_movers_;  ///< last frame's movers decided static (none is found there)
+  std::vector<Detection> prev_people_;  ///< last frame's high-dynamic objects (no mover there)
   /// Recent frames with their final poses (DynamicConfig::dense_check_frames). The last frame
   /// waits in pending_ until the next filter() call brings its final pose.
   DepthHistory depth_history_;

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "dynamap/core/dynamic/class_table.hpp"
+#include "dynamap/core/dynamic/depth_check.hpp"
+#include "dynamap/core/dynamic/nms.hpp"
+#include "dynamap/core/dynamic/region_fusion.hpp"
+
+namespace dynamap {
+
+/// Movers no detector knows (a pushed box, chair or cart): the regions of the current depth that
+/// an earlier view saw through (seenThroughRegions(): something moved in since), outside
+/// `exclude` (CV_8UC1, may be empty: objects decided static, people the detector boxes, the
+/// support planes), one detection of class ClassTable::kMover per connected region. Fusion
+/// tracks them as it tracks a detector's objects: masked until they have shown that they stand
+/// still, carried by the flow when geometry misses them for a frame or two. `T_W_C` is the
+/// current pose (camera -> world), K = fx, fy, cx, cy. *regions (optional): how many.
+std::vector<Detection> moverDetections(const cv::Mat& depth_m, const cv::Matx44d& T_W_C,
+                                       const cv::Vec4d& K, const DepthView& view,
+                                       const cv::Mat& exclude, const SeenThroughOptions& options,
+                                       int* regions = nullptr);
+
+/// Where no mover is looked for (CV_8UC1 of `size`, 255 = not): the movers fusion kept last
+/// frame (`kept_movers`, keptMovers(); a box that stopped), the support planes (`planes`, may be
+/// empty) and the boxes of the high-dynamic detections (people: their own tracks judge them). A
+/// chair the detector knows is looked at: its class says it does not move by itself, not that
+/// nobody pushes it.
+cv::Mat notMovers(const cv::Size& size, const cv::Mat& kept_movers, const cv::Mat& planes,
+                  const std::vector<Detection>& detections, const ClassTable& classes);
+
+/// The pixels of the movers (ClassTable::kMover) that `fused` decided static.
+cv::Mat keptMovers(const FusionResult& fused);
+
+}  // namespace dynamap

@@ -1,0 +1,52 @@
+#include "dynamap/core/dynamic/mover_regions.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+namespace dynamap {
+
+std::vector<Detection> moverDetections(const cv::Mat& depth_m, const cv::Matx44d& T_W_C,
+                                       const cv::Vec4d& K, const DepthView& view,
+                                       const cv::Mat& exclude, const SeenThroughOptions& options,
+                                       int* regions) {
+  std::vector<Detection> out;
+  if (regions != nullptr) *regions = 0;
+  const cv::Mat moved = seenThroughRegions(depth_m, T_W_C, K, view, exclude, options, regions);
+  const cv::Rect bound = cv::boundingRect(moved);
+  if (bound.area() == 0) return out;
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(moved(bound), labels, stats, centroids, 8, CV_32S);
+  for (int c = 1; c < n; ++c) {
+    if (stats.at<int>(c, cv::CC_STAT_AREA) < options.min_region_px) continue;
+    const cv::Rect2f box(static_cast<float>(bound.x + stats.at<int>(c, cv::CC_STAT_LEFT)),
+                         static_cast<float>(bound.y + stats.at<int>(c, cv::CC_STAT_TOP)),
+                         static_cast<float>(stats.at<int>(c, cv::CC_STAT_WIDTH)),
+                         static_cast<float>(stats.at<int>(c, cv::CC_STAT_HEIGHT)));
+    out.push_back(Detection{box, ClassTable::kMover, 1.f});
+  }
+  return out;
+}
+
+cv::Mat notMovers(const cv::Size& size, const cv::Mat& kept_movers, const cv::Mat& planes,
+                  const std::vector<Detection>& detections, const ClassTable& classes) {
+  cv::Mat out = kept_movers.empty() ? cv::Mat::zeros(size, CV_8UC1) : kept_movers.clone();
+  if (!planes.empty()) out |= planes;
+  for (const auto& d : detections) {
+    const cv::Rect box = cv::Rect(d.box) & cv::Rect(0, 0, size.width, size.height);
+    if (classes.isHighDynamic(d.class_id) && box.area() > 0) out(box).setTo(255);
+  }
+  return out;
+}
+
+cv::Mat keptMovers(const FusionResult& fused) {
+  const cv::Mat& kept = fused.static_objects;
+  cv::Mat out = cv::Mat::zeros(kept.size(), CV_8UC1);
+  const cv::Rect image(0, 0, kept.cols, kept.rows);
+  for (const auto& o : fused.objects) {
+    const cv::Rect box = cv::Rect(o.detection.box) & image;
+    if (o.detection.class_id != ClassTable::kMover || o.moving || box.area() <= 0) continue;
+    kept(box).copyTo(out(box), kept(box));
+  }
+  return out;
+}
+
+}  // namespace dynamap
