@@ -22,9 +22,6 @@
 namespace dynamap {
 namespace {
 
-/// Keyframe centroids are kept on a grid this many times finer than the map's voxels.
-constexpr float kCentroidGridPerVoxel = 16.0f;
-
 class PclVoxelBackend final : public MapBackend {
  public:
   explicit PclVoxelBackend(const BackendParams& params) {
@@ -57,8 +54,7 @@ class PclVoxelBackend final : public MapBackend {
       voxels_C.push_back(run);
       b = e;
     }
-    const float grid_m = static_cast<float>(voxel_size_m_) / kCentroidGridPerVoxel;
-    keyframes_.insert_or_assign(view.id, Keyframe{view.T_W_C, {voxels_C, grid_m}});
+    keyframes_.insert_or_assign(view.id, Keyframe{view.T_W_C, plugin::KeyframeVoxels(voxels_C)});
     elements_.reset();
     spillOldKeyframes(view.id);
   }

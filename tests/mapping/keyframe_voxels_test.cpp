@@ -1,5 +1,5 @@
 // The pcl_voxel backend's compact per-keyframe voxels (plugins/pcl_voxel/keyframe_voxels.hpp):
-// centroids, colours and counts come back within the grid's rounding.
+// centroids, colours and counts come back, from RAM and from the spill file.
 #include <gtest/gtest.h>
 
 #include "keyframe_voxels.hpp"
@@ -29,36 +29,24 @@ std::vector<Unpacked> unpack(const plugin::KeyframeVoxels& v) {
   return out;
 }
 
-TEST(KeyframeVoxels, CentroidsColoursAndCountsComeBackWithinTheGrid) {
-  const float grid = 0.01f / 16;
+TEST(KeyframeVoxels, CentroidsColoursAndCountsComeBack) {
   const std::vector<plugin::VoxelAccum> in = {voxelOf({0.1234f, -0.5f, 1.9876f}, 200, 3),
-                                              voxelOf({-2.0f, 1.5f, 4.25f}, 17, 70000)};
-  const plugin::KeyframeVoxels v(in, grid);
+                                              voxelOf({-2.0f, 1.5f, 14.25f}, 17, 70000)};
+  const plugin::KeyframeVoxels v(in);
   EXPECT_EQ(v.bytes(), 2 * sizeof(plugin::CompactVoxel));
   const auto out = unpack(v);
   ASSERT_EQ(out.size(), 2u);
-  EXPECT_LE((out[0].p - Eigen::Vector3f(0.1234f, -0.5f, 1.9876f)).cwiseAbs().maxCoeff(),
-            grid / 2 + 1e-6f);
+  EXPECT_LE((out[0].p - Eigen::Vector3f(0.1234f, -0.5f, 1.9876f)).norm(), 1e-6f);
+  EXPECT_LE((out[1].p - Eigen::Vector3f(-2.0f, 1.5f, 14.25f)).norm(), 1e-5f);
   EXPECT_EQ(out[0].rgb, (std::array<std::uint8_t, 3>{200, 100, 7}));
   EXPECT_EQ(out[0].n, 3u);
   EXPECT_EQ(out[1].n, 65535u);  // saturated, not wrapped
 }
 
-TEST(KeyframeVoxels, FarPointsGetACoarserGridInsteadOfOverflowing) {
-  const float grid = 0.001f / 16;  // 1 mm voxels: int16 reaches only 2 m at this grid
-  const std::vector<plugin::VoxelAccum> in = {voxelOf({0.5f, 0.0f, 6.0f}, 1, 1),
-                                              voxelOf({0.0f, -0.25f, 1.0f}, 1, 1)};
-  const auto out = unpack(plugin::KeyframeVoxels(in, grid));
-  const float unit = 6.0f / 32000.0f;
-  EXPECT_NEAR(out[0].p.z(), 6.0f, unit);
-  EXPECT_NEAR(out[0].p.x(), 0.5f, unit);
-  EXPECT_NEAR(out[1].p.y(), -0.25f, unit);
-}
-
 TEST(KeyframeVoxels, SpilledVoxelsReadBackTheSameAndLeaveRam) {
   const std::vector<plugin::VoxelAccum> in = {voxelOf({0.1f, 0.2f, 0.3f}, 9, 4),
                                               voxelOf({-1.0f, 0.5f, 2.5f}, 250, 1)};
-  plugin::KeyframeVoxels a(in, 0.01f / 16), b(in, 0.01f / 16);
+  plugin::KeyframeVoxels a(in), b(in);
   const auto before = unpack(a);
   plugin::SpillFile<plugin::CompactVoxel> file;
   a.spill(file);
