@@ -46,7 +46,8 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
   schema.addDouble("tracking.kf_max_masked_share", &c.kf_max_masked_share, 0.0, 1.0);
   schema.addDouble("tracking.kf_reuse_distance", &c.kf_reuse_distance, 0.0, 1.0);
-  schema.addDouble("tracking.kf_reuse_max_masked_gain", &c.kf_reuse_max_masked_gain, 0.0, 1.0);
+  schema.addDouble("tracking.kf_reuse_max_uncovered_share", &c.kf_reuse_max_uncovered_share, 0.0,
+                   1.0);
   schema.addDouble("tracking.kf_reuse_min_age_s", &c.kf_reuse_min_age_s, 0.0, 1e9);
   schema.addInt("tracking.kf_reuse_orb_features", &c.kf_reuse_orb_features, 1, 100000);
   schema.addInt("tracking.kf_reuse_orb_fast_threshold", &c.kf_reuse_orb_fast_threshold, 1, 255);
@@ -56,6 +57,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
+  schema.addInt("tracking.ba_global_every_keyframes", &c.ba_global_every_keyframes, 0, 1000000);
   schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);
   schema.addInt("tracking.final_ba_max_iterations", &c.final_ba_max_iterations, 1, 500);
 

@@ -64,17 +64,36 @@ void LocalBundleAdjuster::start() {
   thread_ = std::thread([this] { loop(); });
 }
 
+bool LocalBundleAdjuster::nextRunIsGlobal() {
+  ++requests_;
+  const int every = config_.ba_global_every_keyframes;
+  const bool global = every > 0 && requests_ % every == 0;
+  since_global_ = global ? 0 : since_global_ + 1;
+  return global;
+}
+
 void LocalBundleAdjuster::requestRun() {
+  bool global = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    global = nextRunIsGlobal();
+  }
   // ba_lockstep: the window is taken now, on the tracker's thread, so that what the BA sees
   // (landmarks marked bad per frame included) does not depend on when its thread wakes up.
   std::optional<BaWindow> job;
-  if (config_.ba_lockstep) job = snapshot();
+  if (config_.ba_lockstep) job = snapshot(global);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = true;
+    pending_global_ = global;
     job_ = std::move(job);
   }
   wake_.notify_all();
+}
+
+int LocalBundleAdjuster::runsSinceGlobal() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return since_global_;
 }
 
 void LocalBundleAdjuster::stop() {
@@ -86,12 +105,15 @@ void LocalBundleAdjuster::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-BaWindow LocalBundleAdjuster::snapshot() const {
-  return map_.snapshotWindow(config_.ba_window, config_.ba_fixed_keyframes);
+BaWindow LocalBundleAdjuster::snapshot(bool global) const {
+  const int window = global ? static_cast<int>(map_.keyframeCount()) : config_.ba_window;
+  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes);
+  w.global = global;
+  return w;
 }
 
 bool LocalBundleAdjuster::solve(BaWindow& window) {
-  ScopedStageTimer timer(timings_, "ba");
+  ScopedStageTimer timer(timings_, window.global ? "ba_global" : "ba");
   return solveBundleAdjustment(camera_, config_, window);
 }
 
@@ -110,7 +132,7 @@ void LocalBundleAdjuster::queueUpdates(const std::vector<PoseUpdate>& moved) {
 void LocalBundleAdjuster::runOnce(int window_keyframes, int max_iterations) {
   BaWindow window = window_keyframes > 0
                         ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes)
-                        : snapshot();
+                        : snapshot(false);
   TrackerConfig config = config_;
   if (max_iterations > 0) config.ba_max_iterations = max_iterations;
   ScopedStageTimer timer(timings_, "ba_final");
@@ -138,15 +160,17 @@ std::vector<PoseUpdate> LocalBundleAdjuster::takeUpdates() {
 void LocalBundleAdjuster::loop() {
   std::optional<BaWindow> job;
   for (;;) {
+    bool global = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [this] { return pending_ || stop_; });
       if (stop_) return;
       pending_ = false;
       running_ = true;
+      global = pending_global_;
       job.swap(job_);
     }
-    if (!job) job = snapshot();  // not lockstep: the map as it is now
+    if (!job) job = snapshot(global);  // not lockstep: the map as it is now
     const bool solved = solve(*job);
     if (solved && !config_.ba_lockstep) write(*job);
     {

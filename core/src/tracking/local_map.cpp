@@ -17,7 +17,7 @@ std::uint64_t LocalMap::addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& d
 
 std::uint64_t LocalMap::addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                                     std::vector<KeyframeObservation> observations,
-                                    double masked_share) {
+                                    double masked_share, cv::Mat static_cells) {
   std::lock_guard<std::mutex> lock(mutex_);
   MapKeyframe kf;
   kf.id = keyframes_.size();
@@ -25,6 +25,7 @@ std::uint64_t LocalMap::addKeyframe(double timestamp_s, const Eigen::Isometry3d&
   kf.T_W_C = T_W_C;
   kf.observations = std::move(observations);
   kf.masked_share = masked_share;
+  kf.static_cells = std::move(static_cells);
   for (const auto& o : kf.observations) ++landmarks_[o.landmark_id].keyframes;
   keyframes_.push_back(std::move(kf));
   return keyframes_.back().id;
@@ -188,17 +189,15 @@ std::vector<KeyframeInfo> LocalMap::keyframes() const {
 
 std::vector<std::uint64_t> LocalMap::keyframesNear(const Eigen::Isometry3d& T_W_C,
                                                    double max_translation_m,
-                                                   double max_rotation_deg,
-                                                   double latest_s) const {
+                                                   double max_rotation_deg, double latest_s) const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::pair<double, std::uint64_t>> near;
   const double max_rotation_rad = max_rotation_deg * M_PI / 180.0;
   for (const auto& kf : keyframes_) {
     if (kf.timestamp_s > latest_s && !kf.loaded) continue;
     const Eigen::Isometry3d T_kf_C = kf.T_W_C.inverse() * T_W_C;
-    const double distance =
-        std::max(T_kf_C.translation().norm() / max_translation_m,
-                 Eigen::AngleAxisd(T_kf_C.linear()).angle() / max_rotation_rad);
+    const double distance = std::max(T_kf_C.translation().norm() / max_translation_m,
+                                     Eigen::AngleAxisd(T_kf_C.linear()).angle() / max_rotation_rad);
     if (distance <= 1.0) near.emplace_back(distance, kf.id);
   }
   std::sort(near.begin(), near.end());
@@ -213,7 +212,8 @@ LandmarkCandidates LocalMap::landmarksOf(const std::vector<std::uint64_t>& keyfr
   return landmarksOfLocked(keyframe_ids);
 }
 
-LandmarkCandidates LocalMap::landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const {
+LandmarkCandidates LocalMap::landmarksOfLocked(
+    const std::vector<std::uint64_t>& keyframe_ids) const {
   LandmarkCandidates out;
   std::unordered_set<std::uint64_t> seen;
   for (const auto k : keyframe_ids) {
@@ -246,9 +246,16 @@ std::size_t LocalMap::observationCount(std::uint64_t keyframe_id) const {
   return keyframes_.at(keyframe_id).observations.size();
 }
 
-double LocalMap::maskedShare(std::uint64_t keyframe_id) const {
+std::vector<CoverageView> LocalMap::coverageViews(
+    const std::vector<std::uint64_t>& keyframe_ids) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return keyframes_.at(keyframe_id).masked_share;
+  std::vector<CoverageView> views;
+  views.reserve(keyframe_ids.size());
+  for (const auto id : keyframe_ids) {
+    const MapKeyframe& kf = keyframes_.at(id);
+    views.push_back(CoverageView{kf.T_W_C, kf.static_cells});
+  }
+  return views;
 }
 
 }  // namespace dynamap

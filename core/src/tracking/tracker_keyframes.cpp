@@ -203,8 +203,10 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
     tracks_.push_back(FeatureTrack{id, p, p});
     observations.push_back({id, Eigen::Vector2d(p.x, p.y), z});
   }
-  const std::uint64_t kf_id = map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations),
-                                               maskedShare(certainMask(filtered)));
+  const cv::Mat movers = certainMask(filtered);
+  const std::uint64_t kf_id =
+      map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations), maskedShare(movers),
+                       staticCells(movers, camera_.width, camera_.height));
   ref_kf_ = kf_id;
   ref_T_W_C_ = T_W_C;
   ref_timestamp_s_ = frame.timestamp_s;
@@ -271,10 +273,13 @@ void Tracker::Impl::finish() {
   if (loop_) loop_->stop();
   if (config_.bundle_adjustment) {
     ba_.applyFinished();  // not lockstep: a solve that finished meanwhile
-    // Every keyframe (or the newest final_ba_window) at once: the local windows left the drift
-    // of the older ones in place.
+    // The keyframes no global BA has seen yet and a local window more (every keyframe without
+    // periodic global BAs), or the newest final_ba_window: the local windows left their drift.
+    const int all = static_cast<int>(map_.keyframeCount());
     const int window = config_.final_ba_window > 0 ? config_.final_ba_window
-                                                   : static_cast<int>(map_.keyframeCount());
+                       : config_.ba_global_every_keyframes > 0
+                           ? std::min(all, ba_.runsSinceGlobal() + config_.ba_window)
+                           : all;
     ba_.runOnce(window, config_.final_ba_max_iterations);
   }
 }

@@ -61,8 +61,8 @@ std::vector<std::uint64_t> Tracker::Impl::localKeyframes(const Eigen::Isometry3d
     ids.push_back(static_cast<std::uint64_t>(k));
   }
   if (config_.kf_reuse_distance <= 0.0) return ids;
-  for (const auto k : map_.keyframesNear(T_W_C, config_.kf_max_translation_m,
-                                         config_.kf_max_rotation_deg)) {
+  for (const auto k :
+       map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg)) {
     if (std::find(ids.begin(), ids.end(), k) == ids.end()) ids.push_back(k);
   }
   return ids;
@@ -105,6 +105,22 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(const RgbdFrame& frame
   return found;
 }
 
+// What of the frame's static view no keyframe near it saw outside its movers.
+double Tracker::Impl::uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
+                                    const Eigen::Isometry3d& T_W_C) const {
+  std::vector<std::uint64_t> near =
+      map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
+  near.resize(std::min(near.size(), kReuseSourceKeyframes));
+  CoverageQuery query;
+  query.camera = &camera_;
+  query.depth_m = &frame.depth_m;
+  query.movers = &movers;
+  query.T_W_C = T_W_C;
+  query.depth_min_m = config_.depth_min_m;
+  query.depth_max_m = config_.depth_max_m;
+  return uncoveredShare(query, map_.coverageViews(near));
+}
+
 bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                   const cv::Mat& track_mask, const cv::Mat& movers,
                                   Eigen::Isometry3d& T_W_C, int& inliers) {
@@ -116,7 +132,7 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                          frame.timestamp_s - config_.kf_reuse_min_age_s);
   if (near.empty()) return false;
   const std::uint64_t kf = near.front();
-  if (map_.maskedShare(kf) > maskedShare(movers) + config_.kf_reuse_max_masked_gain) return false;
+  if (uncoveredView(frame, movers, T_W_C) > config_.kf_reuse_max_uncovered_share) return false;
 
   const std::vector<FeatureTrack> saved = tracks_;
   mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C));

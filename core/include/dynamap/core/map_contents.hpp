@@ -28,6 +28,9 @@ struct MapKeyframe {
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::vector<KeyframeObservation> observations;
   double masked_share = 0.0;  ///< share of its image under the motion mask when it was made
+  /// Its view outside the motion mask on a coarse grid (view_coverage.hpp; not saved: empty,
+  /// static everywhere, for a saved map's keyframes).
+  cv::Mat static_cells;
   /// From a saved map (an earlier run): held fixed by bundle adjustment, and older than any
   /// keyframe of this run for revisits whatever its timestamp.
   bool loaded = false;

@@ -89,8 +89,8 @@ class Tracker {
   void markBadFrame(double timestamp_s);
   /// Keyframe poses corrected by BA since the last call. Thread-safe.
   std::vector<PoseUpdate> takePoseUpdates();
-  /// Stops the BA thread, then one BA over every keyframe (TrackerConfig::final_ba_window).
-  /// Idempotent.
+  /// Stops the BA thread, then one BA over the keyframes made since its last run over every
+  /// keyframe and a local window more (TrackerConfig::final_ba_window). Idempotent.
   void finish();
 
   /// One entry per frame given to track() (not bad frames): the pose relative to its reference

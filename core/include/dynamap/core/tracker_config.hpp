@@ -87,12 +87,14 @@ struct TrackerConfig {
   /// new landmarks beside the old ones: keyframes grow with the space explored, not with time
   /// (0 = off).
   double kf_reuse_distance = 0.5;
-  /// ... unless its motion mask covered more than this share of the image more than the
-  /// frame's does: the new view shows static scene the old one had masked.
-  double kf_reuse_max_masked_gain = 0.02;
-  /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
-  /// The keyframes of one pass give the map its views of movers from several times.
-  double kf_reuse_min_age_s = 5.0;
+  /// ... unless more than this share of the frame's static view (outside its motion mask) lies
+  /// outside the static views of the keyframes near it: a new keyframe adds that to the map
+  /// (static scene the old ones had masked, or had not seen).
+  double kf_reuse_max_uncovered_share = 0.05;
+  /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere
+  /// (the newest keyframes are tracked anyway). Views of movers from several times come from
+  /// the coverage test above.
+  double kf_reuse_min_age_s = 1.5;
   /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
   /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
   /// third of the landmarks in view (teddy x10: 144 keyframes; 3000 at 7: 96).
@@ -108,8 +110,13 @@ struct TrackerConfig {
   int ba_window = 8;           ///< keyframes optimised together
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
   int ba_max_iterations = 10;
+  /// Every this many keyframes the BA thread optimises every keyframe instead of the newest
+  /// ba_window (stage "ba_global"): revisits and their drift are settled during the run, not
+  /// in one batch at finish() that grows with the run (0 = never).
+  int ba_global_every_keyframes = 16;
   /// The last bundle adjustment, at finish(), optimises the newest this many keyframes together,
-  /// the oldest ba_fixed_keyframes of them held fixed (0 = every keyframe). The trajectory and
+  /// the oldest ba_fixed_keyframes of them held fixed. 0: those made since the last global BA
+  /// and ba_window more (every keyframe when ba_global_every_keyframes is 0). The trajectory and
   /// the map take its poses; the masks and every online decision were made before it.
   int final_ba_window = 0;
   int final_ba_max_iterations = 10;

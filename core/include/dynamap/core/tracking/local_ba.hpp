@@ -46,6 +46,8 @@ class LocalBundleAdjuster {
   /// One synchronous solve in the caller's thread ("ba_final"), of the newest window_keyframes
   /// (0 = ba_window) with at most max_iterations (0 = ba_max_iterations).
   void runOnce(int window_keyframes = 0, int max_iterations = 0);
+  /// Runs requested since the last one over every keyframe (ba_global_every_keyframes).
+  int runsSinceGlobal() const;
   std::vector<PoseUpdate> takeUpdates();
   /// Poses moved by someone else (loop closure) join the queue of takeUpdates(), in order.
   void queueUpdates(const std::vector<PoseUpdate>& moved);
@@ -54,8 +56,10 @@ class LocalBundleAdjuster {
 
  private:
   void loop();
-  BaWindow snapshot() const;           ///< the current window of the map
-  bool solve(BaWindow& window);        ///< timed as "ba"; false = nothing solved
+  /// The current window of the map: every keyframe if `global`, else the newest ba_window.
+  BaWindow snapshot(bool global) const;
+  bool solve(BaWindow& window);        ///< timed as "ba" or "ba_global"; false = nothing solved
+  bool nextRunIsGlobal();              ///< counts the request (requestRun(), under mutex_)
   void write(const BaWindow& solved);  ///< into the map; moved poses queue for takeUpdates()
 
   PinholeCamera camera_;
@@ -63,11 +67,14 @@ class LocalBundleAdjuster {
   LocalMap& map_;
   TimingRecorder* timings_;
   WriteListener listener_;  ///< set before start(), then read only
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool pending_ = false;
   bool running_ = false;
   bool stop_ = false;
+  int requests_ = 0;                ///< requestRun() calls
+  int since_global_ = 0;            ///< of them since the last global run
+  bool pending_global_ = false;     ///< not lockstep: the pending run takes every keyframe
   std::optional<BaWindow> job_;     ///< ba_lockstep: the window requestRun() took
   std::optional<BaWindow> solved_;  ///< ba_lockstep: a finished solve not yet written
   std::thread thread_;

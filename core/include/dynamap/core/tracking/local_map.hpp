@@ -12,6 +12,7 @@
 #include "dynamap/core/map_contents.hpp"
 #include "dynamap/core/tracker.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
+#include "dynamap/core/tracking/view_coverage.hpp"
 
 namespace dynamap {
 
@@ -31,7 +32,8 @@ struct BaWindow {
   std::vector<std::uint64_t> landmark_ids;
   std::vector<Eigen::Vector3d> points;
   std::vector<Observation> observations;
-  int generation = 0;  ///< LocalMap::generation() when taken: a stale window is not applied
+  int generation = 0;   ///< LocalMap::generation() when taken: a stale window is not applied
+  bool global = false;  ///< every keyframe of the map (ba_global_every_keyframes)
 };
 
 /// Landmarks and keyframes shared by the tracking and BA threads. Every method is thread-safe;
@@ -41,7 +43,7 @@ class LocalMap {
   std::uint64_t addLandmark(const Eigen::Vector3d& p_W, const cv::Mat& descriptor);
   std::uint64_t addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                             std::vector<KeyframeObservation> observations,
-                            double masked_share = 0.0);
+                            double masked_share = 0.0, cv::Mat static_cells = cv::Mat());
   std::size_t keyframeCount() const;
   Eigen::Isometry3d keyframePose(std::uint64_t id) const;
   /// Landmarks observed inside a dynamic region: left out of BA and relocalization from now on.
@@ -77,8 +79,8 @@ class LocalMap {
   /// Keyframes whose pose is within `max_translation_m` and `max_rotation_deg` of T_W_C, made
   /// at `latest_s` or before, the nearest first (by the larger of the two distances, each over
   /// its limit).
-  std::vector<std::uint64_t> keyframesNear(const Eigen::Isometry3d& T_W_C,
-                                           double max_translation_m, double max_rotation_deg,
+  std::vector<std::uint64_t> keyframesNear(const Eigen::Isometry3d& T_W_C, double max_translation_m,
+                                           double max_rotation_deg,
                                            double latest_s = INFINITY) const;
   /// The good landmarks those keyframes observed, each once, in the keyframes' order.
   LandmarkCandidates landmarksOf(const std::vector<std::uint64_t>& keyframe_ids) const;
@@ -88,7 +90,8 @@ class LocalMap {
   /// Replaces the contents with a saved map's, its keyframes marked loaded (fixed in bundle
   /// adjustment, old enough for any revisit). Ids must be dense (MapContents).
   void restore(MapContents contents);
-  double maskedShare(std::uint64_t keyframe_id) const;
+  /// Poses and static cells of these keyframes (view_coverage.hpp).
+  std::vector<CoverageView> coverageViews(const std::vector<std::uint64_t>& keyframe_ids) const;
 
  private:
   LandmarkCandidates landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const;

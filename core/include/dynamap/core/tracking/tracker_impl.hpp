@@ -121,6 +121,10 @@ class Tracker::Impl {
   /// frame tracks its landmarks (pose refined with them); false (nothing changed) if none does.
   bool reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
                      const cv::Mat& movers, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// Share of the frame's static view that the keyframes near T_W_C did not see outside their
+  /// movers (view_coverage.hpp).
+  double uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
+                       const Eigen::Isometry3d& T_W_C) const;
   /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
   std::vector<std::uint64_t> localKeyframes(const Eigen::Isometry3d& T_W_C) const;
   std::vector<std::uint64_t> trackedLandmarks() const;
@@ -134,8 +138,8 @@ class Tracker::Impl {
   /// New landmarks come from outside `track_mask`; the packet carries the filter's masks.
   /// A loop correction landing here moves T_W_C.
   KeyframePacketPtr createKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
-                                   Eigen::Isometry3d& T_W_C,
-                                   const MotionFilterOutput& filtered, const cv::Mat& track_mask);
+                                   Eigen::Isometry3d& T_W_C, const MotionFilterOutput& filtered,
+                                   const cv::Mat& track_mask);
   OrbFeatures extractOrb(const cv::Mat& gray, const cv::Mat& dynamic_mask);
   /// tracker_loop.cpp: the loop thread started, BA's moves forwarded to it (constructor).
   void startLoopClosure();
@@ -180,7 +184,7 @@ class Tracker::Impl {
   Eigen::Isometry3d T_W_last_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
-  PosedDepth last_depth_;  ///< the last tracked frame's depth, moving mask and pose
+  PosedDepth last_depth_;        ///< the last tracked frame's depth, moving mask and pose
   bool posed_by_depth_ = false;  ///< this frame's pose came from alignToLastDepth
 
   std::uint64_t ref_kf_ = 0;
