@@ -4,12 +4,14 @@
 // current poses and merged by world voxel, at export. No whole-map structure lives between
 // exports: memory is the keyframes' reduced clouds (the newest resident_keyframes in RAM, the
 // others in a temporary file), and a pose update costs nothing.
+#include <array>
 #include <deque>
 #include <map>
 #include <memory>
 #include <optional>
 
 #include <pcl/filters/statistical_outlier_removal.h>
+#include <tbb/parallel_for.h>
 
 #include "dynamap/mapping/backend_params.hpp"
 #include "dynamap/mapping/flat_index.hpp"
@@ -133,11 +135,11 @@ class PclVoxelBackend final : public MapBackend {
     std::vector<plugin::CompactVoxel> buffer;
     for (const auto& kv : keyframes_) {
       const Eigen::Isometry3f T = kv.second.T_W_C.cast<float>();
-      kv.second.voxels.forEach(buffer, [&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb,
-                                   std::uint32_t n) {
-        const Eigen::Vector3f p_W = T * p_C;
-        f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
-      });
+      kv.second.voxels.forEach(
+          buffer, [&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb, std::uint32_t n) {
+            const Eigen::Vector3f p_W = T * p_C;
+            f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
+          });
     }
   }
 
@@ -147,26 +149,50 @@ class PclVoxelBackend final : public MapBackend {
     return n;
   }
 
-  /// The map: every keyframe's voxels at its current pose, merged by world voxel (in the order
-  /// of their first keyframe).
+  /// The map: every keyframe's voxels at its current pose, merged by world voxel. Two halves
+  /// of the world's voxels (by a hash of the key) are merged at once on two threads, each in
+  /// the order of their first keyframe, the first half first.
   std::vector<plugin::VoxelAccum> mergedVoxels() const {
-    FlatIndex index(placedVoxelCount() / 2);
-    std::vector<plugin::VoxelAccum> merged;
-    forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f& p_W,
-                           const std::uint8_t* rgb, std::uint32_t n) {
-      const auto slot = index.tryEmplace(key, static_cast<std::uint32_t>(merged.size()));
-      if (slot.second) merged.emplace_back();
-      merged[slot.first].add(p_W, rgb, n);
+    std::array<std::vector<plugin::VoxelAccum>, kMergeHalves> merged;
+    tbb::parallel_for(0, kMergeHalves, [&](int half) {
+      FlatIndex index(expectedVoxels() / kMergeHalves);
+      std::vector<plugin::VoxelAccum>& out = merged[static_cast<std::size_t>(half)];
+      out.reserve(expectedVoxels() / kMergeHalves);
+      forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f& p_W, const std::uint8_t* rgb,
+                             std::uint32_t n) {
+        if (halfOf(key) != half) return;
+        const auto slot = index.tryEmplace(key, static_cast<std::uint32_t>(out.size()));
+        if (slot.second) out.emplace_back();
+        out[slot.first].add(p_W, rgb, n);
+      });
     });
-    return merged;
+    for (int h = 1; h < kMergeHalves; ++h) {
+      merged[0].insert(merged[0].end(), merged[h].begin(), merged[h].end());
+    }
+    return std::move(merged[0]);
   }
 
   std::size_t distinctVoxels() const {
-    FlatIndex index(placedVoxelCount() / 2);
-    forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*,
-                           std::uint32_t) { index.tryEmplace(key, 0); });
-    return index.size();
+    std::array<std::size_t, kMergeHalves> count{};
+    tbb::parallel_for(0, kMergeHalves, [&](int half) {
+      FlatIndex index(expectedVoxels() / kMergeHalves);
+      forEachPlacedVoxel(
+          [&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*, std::uint32_t) {
+            if (halfOf(key) == half) index.tryEmplace(key, 0);
+          });
+      count[static_cast<std::size_t>(half)] = index.size();
+    });
+    std::size_t n = 0;
+    for (const std::size_t c : count) n += c;
+    return n;
   }
+
+  static constexpr int kMergeHalves = 2;
+  static int halfOf(std::uint64_t key) {
+    return static_cast<int>((key * 0x9E3779B97F4A7C15ull) >> 63);  // Fibonacci hash, top bit
+  }
+  /// The map's distinct voxels if known, else half the placed ones.
+  std::size_t expectedVoxels() const { return elements_ ? *elements_ : placedVoxelCount() / 2; }
 
   double voxel_size_m_ = 0.01;
   float inv_voxel_ = 100.0f;
@@ -177,7 +203,7 @@ class PclVoxelBackend final : public MapBackend {
   int resident_keyframes_ = 32;
   std::unique_ptr<plugin::SpillFile<plugin::CompactVoxel>> spill_;  ///< made at the first spill
   std::map<std::uint64_t, Keyframe> keyframes_;
-  std::deque<std::uint64_t> resident_;  ///< keyframes in RAM, oldest first
+  std::deque<std::uint64_t> resident_;           ///< keyframes in RAM, oldest first
   mutable std::optional<std::size_t> elements_;  ///< distinct voxels, until the map changes
 };
 

@@ -2,7 +2,10 @@
 
 // An unnamed temporary file (removed by the system when closed, even after a crash) holding
 // keyframes' compact voxels once they leave the newest keyframes: RAM then holds the active
-// keyframes only, and an export streams the others back.
+// keyframes only, and an export streams the others back (read() is safe on several threads at
+// once: positioned reads, no shared file offset).
+
+#include <unistd.h>
 
 #include <cstdio>
 #include <string>
@@ -30,7 +33,8 @@ class SpillFile {
   Span append(const std::vector<Record>& records) {
     Span span{end_, records.size()};
     if (fseeko(file_, end_, SEEK_SET) != 0 ||
-        std::fwrite(records.data(), sizeof(Record), records.size(), file_) != records.size()) {
+        std::fwrite(records.data(), sizeof(Record), records.size(), file_) != records.size() ||
+        std::fflush(file_) != 0) {
       throw MappingError("cannot write the map's keyframes to a temporary file (disk full?)");
     }
     end_ += static_cast<long long>(records.size() * sizeof(Record));
@@ -39,9 +43,15 @@ class SpillFile {
 
   void read(const Span& span, std::vector<Record>& out) const {
     out.resize(span.count);
-    if (fseeko(file_, span.offset, SEEK_SET) != 0 ||
-        std::fread(out.data(), sizeof(Record), span.count, file_) != span.count) {
-      throw MappingError("cannot read the map's keyframes back from their temporary file");
+    auto* bytes = reinterpret_cast<char*>(out.data());
+    const std::size_t total = span.count * sizeof(Record);
+    for (std::size_t done = 0; done < total;) {
+      const ssize_t n = ::pread(fileno(file_), bytes + done, total - done,
+                                static_cast<off_t>(span.offset + static_cast<long long>(done)));
+      if (n <= 0) {
+        throw MappingError("cannot read the map's keyframes back from their temporary file");
+      }
+      done += static_cast<std::size_t>(n);
     }
   }
 
