@@ -1,6 +1,7 @@
 // `vdb_tsdf`: OpenVDB colour TSDF with projective integration and space carving
 // (tsdf_volume.hpp). Exports mesh.ply, mesh.obj and tsdf.vdb. Pose updates: the mapping worker
-// rebuilds the volume with the final poses (PoseUpdateMode::kReintegrate).
+// rebuilds the volume with the final poses (PoseUpdateMode::kReintegrate). A saved map's
+// tsdf.vdb (importMap()) is the volume's start, to which each rebuild's reset() returns.
 #include <exception>
 #include <filesystem>
 #include <string>
@@ -54,6 +55,10 @@ class VdbTsdfBackend final : public MapBackend {
   void reset() override {
     volume_.reset();
     keyframes_ = 0;
+  }
+  bool importMap(const std::string& dir) override {
+    volume_.importVdb((std::filesystem::path(dir) / "tsdf.vdb").string());
+    return true;
   }
 
   void exportMap(const std::string& dir) override {
