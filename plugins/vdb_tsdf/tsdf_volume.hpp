@@ -32,6 +32,12 @@ struct TsdfOptions {
   float free_vote_ratio = 0.5f;
 };
 
+/// "crc32 <8 hex digits> bytes <n>" of the file at `path` (zlib's crc32). Written beside
+/// tsdf.vdb as tsdf.vdb.crc32 and checked before OpenVDB parses the file: a length in a damaged
+/// header makes OpenVDB allocate what it says (4 GB). Throws MappingError naming the file.
+std::string fileDigest(const std::string& path);
+inline constexpr const char* kDigestSuffix = ".crc32";
+
 /// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight = views within the
 /// truncation band, colour, and with free_votes the see-through votes), integrated
 /// projectively: the 8^3 leaf blocks within the truncation band of the observed depth (and, with
@@ -46,7 +52,8 @@ class TsdfVolume {
   /// Back to the imported grids (importVdb()), or empty.
   void reset();
   /// Starts from the grids writeVdb() wrote to `path`, which reset() then comes back to. Checked
-  /// first (tsdf_volume_io.cpp): grids tsdf, weight and color (free_views optional) of their
+  /// first (tsdf_volume_io.cpp): the file against its digest `path`.crc32 where there is one
+  /// (maps saved before it have none), grids tsdf, weight and color (free_views optional) of their
   /// types and backgrounds, this volume's voxel size and unshifted transform, its truncation_m
   /// where recorded, values finite and in range. Throws MappingError "<path>: <field>: <what>"
   /// and leaves the volume as it was.

@@ -1,10 +1,16 @@
 // TsdfVolume's file: writeVdb() and, for a saved map, readVdb() with every field checked before
 // it is used (a saved volume of another voxel size or truncation would fuse wrong values).
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include <zlib.h>
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 
 #include "dynamap/mapping/map_backend.hpp"
 #include "tsdf_volume.hpp"
@@ -21,18 +27,36 @@ class VdbReader {
     throw MappingError(path_ + ": " + field + ": " + what);
   }
 
-  /// Every grid of the file (the file closed again); a file OpenVDB cannot read is one error.
+  /// Every grid of the file. The stream throws at the first read that fails: OpenVDB would go
+  /// on with what it did not read (a truncated file's string length: gigabytes allocated).
   openvdb::GridPtrVecPtr readAll() const {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path_, ec)) bad("file", "no such file");
+    checkDigest();
     try {
-      openvdb::io::File file(path_);
-      file.open(/*delayLoad=*/false);
-      openvdb::GridPtrVecPtr grids = file.getGrids();
-      file.close();
-      return grids;
+      std::ifstream in(path_, std::ios::binary);
+      in.exceptions(std::ios::failbit | std::ios::badbit | std::ios::eofbit);
+      openvdb::io::Stream stream(in, /*delayLoad=*/false);
+      return stream.getGrids();
+    } catch (const std::ios_base::failure&) {
+      bad("file", "truncated or unreadable (a read went past its end)");
     } catch (const std::exception& e) {
-      bad("file", std::string("not a readable OpenVDB file (") + e.what() + ")");
+      bad("file", "not a readable OpenVDB file (" + clipped(e.what()) + ")");
+    }
+  }
+
+  /// The file against the digest beside it, if any.
+  void checkDigest() const {
+    const std::string digest_path = path_ + kDigestSuffix;
+    std::error_code ec;
+    if (!std::filesystem::exists(digest_path, ec)) return;
+    std::ifstream in(digest_path);
+    std::string saved;
+    std::getline(in, saved);
+    const std::string now = fileDigest(path_);
+    if (saved != now) {
+      bad("checksum",
+          "'" + now + "', " + digest_path + " says '" + clipped(saved) + "' (damaged or replaced)");
     }
   }
 
@@ -90,6 +114,19 @@ class VdbReader {
   }
 
  private:
+  /// A library's message as one short line (a corrupt file's may hold its garbage).
+  static std::string clipped(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+      const bool space = std::isspace(static_cast<unsigned char>(c)) != 0;
+      if (!std::isprint(static_cast<unsigned char>(c)) && !space) continue;
+      if (space && (out.empty() || out.back() == ' ')) continue;
+      out += space ? ' ' : c;
+      if (out.size() >= 120) return out + "...";
+    }
+    return out;
+  }
+
   static std::string number(double v) {
     char buf[32];
     std::snprintf(buf, sizeof(buf), "%.10g", v);
@@ -100,6 +137,24 @@ class VdbReader {
 };
 
 }  // namespace
+
+std::string fileDigest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MappingError(path + ": cannot open");
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::uintmax_t bytes = 0;
+  std::vector<char> buffer(1 << 20);
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto n = static_cast<std::size_t>(in.gcount());
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(buffer.data()), static_cast<uInt>(n));
+    bytes += n;
+  }
+  char text[64];
+  std::snprintf(text, sizeof(text), "crc32 %08lx bytes %ju", static_cast<unsigned long>(crc),
+                bytes);
+  return text;
+}
 
 TsdfVolume::Grids TsdfVolume::readVdb(const std::string& path) const {
   const VdbReader reader(path);

@@ -188,6 +188,31 @@ TEST_P(BackendReload, VolumeOfAnotherVoxelSizeIsRefusedByName) {
   expectImportError(*backend, saved, savedFile(saved), key, 0);
 }
 
+// vdb_tsdf writes tsdf.vdb's digest beside it: a damaged byte is refused before OpenVDB parses
+// the file (a length in its header taken from garbage is allocated as it says: 4 GB), also where
+// the grids would pass every check (a voxel value).
+TEST(BackendReloadVdb, DamagedFileIsRefusedByItsDigest) {
+  const auto registry = BackendRegistry::scan({pluginDir()});
+  if (registry.pluginPath("vdb_tsdf").empty()) GTEST_SKIP() << "vdb_tsdf not built";
+  const BackendParams params = backendCase("vdb_tsdf").params;
+  const fs::path saved = freshTempDir("reload_digest");
+  mapSteps(registry.create("vdb_tsdf", params), kRun1, {}, saved);
+  const fs::path file = saved / "tsdf.vdb";
+  ASSERT_TRUE(fs::exists(saved / "tsdf.vdb.crc32"));
+  const auto size = fs::file_size(file);
+  for (const std::uintmax_t at : {std::uintmax_t{140}, size / 2}) {
+    const fs::path bad = freshTempDir("reload_digest_bad");
+    fs::copy(saved, bad, fs::copy_options::recursive);
+    {
+      std::fstream f(bad / "tsdf.vdb", std::ios::in | std::ios::out | std::ios::binary);
+      f.seekp(static_cast<std::streamoff>(at));
+      f.write("\xff\xff\xff\xff", 4);
+    }
+    auto backend = registry.create("vdb_tsdf", params);
+    expectImportError(*backend, bad, bad / "tsdf.vdb", "checksum", 0);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllBackends, BackendReload, ::testing::ValuesIn(reloadableNames()),
                          [](const auto& info) { return info.param; });
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BackendReload);
