@@ -1,10 +1,13 @@
-// TsdfVolume's file: writeVdb() and, for a saved map, readVdb() with every field checked before
-// it is used (a saved volume of another voxel size or truncation would fuse wrong values).
+// TsdfVolume's file: writeVdb(), fileDigest() for the digest written beside it and, for a saved
+// map, readVdb() with every field checked before it is used (a saved volume of another voxel
+// size or truncation would fuse wrong values).
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <zlib.h>
