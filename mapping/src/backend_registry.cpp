@@ -28,6 +28,7 @@ class PluginBackend final : public MapBackend {
   MapStats stats() const override { return inner_->stats(); }
   bool fusesViews() const override { return inner_->fusesViews(); }
   bool needsPoints() const override { return inner_->needsPoints(); }
+  bool importMap(const std::string& dir) override { return inner_->importMap(dir); }
 
  private:
   std::shared_ptr<void> handle_;

@@ -33,6 +33,23 @@ inline void saveCloudPlyPcd(const pcl::PointCloud<pcl::PointXYZRGB>& cloud,
   });
 }
 
+/// <dir>/cloud.ply as saveCloudPlyPcd() wrote it (world points; light grey where the file has
+/// no colours). Throws MappingError naming the file: missing, not a PLY, truncated, a point
+/// that is not finite.
+inline PlyData loadCloudPly(const std::string& dir) {
+  const std::string path = (std::filesystem::path(dir) / "cloud.ply").string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw MappingError(path + ": no such file");
+  PlyData ply = readPly(path);
+  for (std::size_t i = 0; i < ply.vertices.size(); ++i) {
+    if (!ply.vertices[i].allFinite()) {
+      throw MappingError(path + ": vertex " + std::to_string(i) + ": x/y/z is not finite");
+    }
+  }
+  ply.colors.resize(ply.vertices.size(), {200, 200, 200});
+  return ply;
+}
+
 inline pcl::PointXYZRGB makePoint(const Eigen::Vector3f& p, const std::array<std::uint8_t, 3>& c) {
   pcl::PointXYZRGB q;
   q.x = p.x();

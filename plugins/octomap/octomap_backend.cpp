@@ -3,7 +3,8 @@
 // they hit before ray casting (lazy evaluation; inner nodes are updated at export). The ray
 // casting of a keyframe runs on another thread while the previous keyframe's cells are updated
 // in the tree, in keyframe order (the same updates as insertPointCloud, the same map).
-// Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres).
+// Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres). A saved
+// map's map.ot (importMap()) is the tree's start, to which each rebuild's reset() returns.
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "dynamap/mapping/plugin_api.hpp"
 #include "dynamap/mapping/ply_io.hpp"
 #include "occupancy_grid.hpp"
+#include "octree_file.hpp"
 
 namespace dynamap {
 namespace {
@@ -23,28 +25,23 @@ constexpr double kDefaultResolutionM = 0.03;
 
 class OctomapBackend final : public MapBackend {
  public:
-  explicit OctomapBackend(const BackendParams& params)
-      : tree_(kDefaultResolutionM), caster_(kDefaultResolutionM) {
+  explicit OctomapBackend(const BackendParams& params) : caster_(kDefaultResolutionM) {
     ParamReader reader("octomap", params);
-    const double res = reader.getDouble("resolution_m", kDefaultResolutionM, 0.005, 10.0);
+    resolution_m_ = reader.getDouble("resolution_m", kDefaultResolutionM, 0.005, 10.0);
     max_range_m_ = reader.getDouble("max_range_m", -1.0, -1.0, 1000.0);
     discretize_ = reader.getBool("discretize", true);
-    const double hit = reader.getDouble("prob_hit", 0.7, 0.5, 1.0);
-    const double miss = reader.getDouble("prob_miss", 0.4, 0.0, 0.5);
-    const double cmin = reader.getDouble("clamp_min", 0.12, 0.0, 0.5);
-    const double cmax = reader.getDouble("clamp_max", 0.97, 0.5, 1.0);
+    prob_hit_ = reader.getDouble("prob_hit", 0.7, 0.5, 1.0);
+    prob_miss_ = reader.getDouble("prob_miss", 0.4, 0.0, 0.5);
+    clamp_min_ = reader.getDouble("clamp_min", 0.12, 0.0, 0.5);
+    clamp_max_ = reader.getDouble("clamp_max", 0.97, 0.5, 1.0);
     const std::string up = reader.getString("up_axis", "z", {"x", "y", "z", "-x", "-y", "-z"});
     grid_.up_sign = up[0] == '-' ? -1 : 1;
     grid_.up_axis = up.back() - 'x';
     grid_.min_height_m = reader.getDouble("grid_min_height_m", 0.1, -1e4, 1e4);
     grid_.max_height_m = reader.getDouble("grid_max_height_m", 2.0, -1e4, 1e4);
     reader.finish();
-    tree_.setResolution(res);
-    caster_.setResolution(res);
-    tree_.setProbHit(hit);
-    tree_.setProbMiss(miss);
-    tree_.setClampingThresMin(cmin);
-    tree_.setClampingThresMax(cmax);
+    caster_.setResolution(resolution_m_);
+    reset();
   }
 
   void integrate(const KeyframeView& view) override {
@@ -57,8 +54,8 @@ class OctomapBackend final : public MapBackend {
       for (const auto& p_C : *view.points_C) {
         const Eigen::Vector3f p = T * p_C;
         octomap::OcTreeKey key;
-        if (!tree_.coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
-        if (seen.insert(key).second) cloud.push_back(tree_.keyToCoord(key));
+        if (!tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
+        if (seen.insert(key).second) cloud.push_back(tree_->keyToCoord(key));
       }
     } else {
       for (const auto& p_C : *view.points_C) {
@@ -85,8 +82,17 @@ class OctomapBackend final : public MapBackend {
   bool fusesViews() const override { return true; }
   void reset() override {
     if (pending_.valid()) pending_.get();
-    tree_.clear();
+    tree_ = loaded_ ? std::make_unique<octomap::OcTree>(*loaded_)
+                    : std::make_unique<octomap::OcTree>(resolution_m_);
+    configure(*tree_);
+    dirty_inner_ = false;
     keyframes_ = 0;
+  }
+  bool importMap(const std::string& dir) override {
+    loaded_ =
+        plugin::readOcTreeFile((std::filesystem::path(dir) / "map.ot").string(), resolution_m_);
+    reset();
+    return true;
   }
 
   void exportMap(const std::string& dir) override {
@@ -95,12 +101,12 @@ class OctomapBackend final : public MapBackend {
     finalizeTree();
     const fs::path d(dir);
     writeAtomically((d / "map.bt").string(), [&](const std::string& tmp) {
-      if (!tree_.writeBinaryConst(tmp)) throw MappingError(tmp + ": OctoMap write failed");
+      if (!tree_->writeBinaryConst(tmp)) throw MappingError(tmp + ": OctoMap write failed");
     });
     writeAtomically((d / "map.ot").string(), [&](const std::string& tmp) {
-      if (!tree_.write(tmp)) throw MappingError(tmp + ": OctoMap write failed");
+      if (!tree_->write(tmp)) throw MappingError(tmp + ": OctoMap write failed");
     });
-    plugin::writeOccupancyGrid(tree_, grid_, dir);
+    plugin::writeOccupancyGrid(*tree_, grid_, dir);
     PlyData cloud;
     cloud.vertices = occupiedCentres();
     writeAtomically((d / "cloud.ply").string(),
@@ -111,10 +117,10 @@ class OctomapBackend final : public MapBackend {
     drain();
     MapStats s;
     s.keyframes = keyframes_;
-    for (auto it = tree_.begin_leafs(), end = tree_.end_leafs(); it != end; ++it) {
-      if (tree_.isNodeOccupied(*it)) ++s.elements;
+    for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+      if (tree_->isNodeOccupied(*it)) ++s.elements;
     }
-    s.memory_bytes = tree_.memoryUsage();
+    s.memory_bytes = tree_->memoryUsage();
     s.element_kind = "occupied_cells";
     return s;
   }
@@ -123,27 +129,34 @@ class OctomapBackend final : public MapBackend {
   struct Cells {
     octomap::KeySet free, occupied;
   };
+  /// This run's sensor model and clamping (a loaded tree keeps its log-odds, not its model).
+  void configure(octomap::OcTree& tree) const {
+    tree.setProbHit(prob_hit_);
+    tree.setProbMiss(prob_miss_);
+    tree.setClampingThresMin(clamp_min_);
+    tree.setClampingThresMax(clamp_max_);
+  }
   /// insertPointCloud's updates: the free cells, then the occupied ones.
   void apply(const Cells& cells) const {
-    for (const auto& key : cells.free) tree_.updateNode(key, false, /*lazy_eval=*/true);
-    for (const auto& key : cells.occupied) tree_.updateNode(key, true, /*lazy_eval=*/true);
+    for (const auto& key : cells.free) tree_->updateNode(key, false, /*lazy_eval=*/true);
+    for (const auto& key : cells.occupied) tree_->updateNode(key, true, /*lazy_eval=*/true);
   }
   void drain() const {
     if (pending_.valid()) apply(*pending_.get());
   }
   void finalizeTree() {
     drain();
-    if (dirty_inner_) tree_.updateInnerOccupancy();
+    if (dirty_inner_) tree_->updateInnerOccupancy();
     dirty_inner_ = false;
   }
 
   // Centres of the occupied finest-level voxels (pruned nodes expanded).
   std::vector<Eigen::Vector3f> occupiedCentres() const {
     std::vector<Eigen::Vector3f> out;
-    const double res = tree_.getResolution();
-    const unsigned max_depth = tree_.getTreeDepth();
-    for (auto it = tree_.begin_leafs(), end = tree_.end_leafs(); it != end; ++it) {
-      if (!tree_.isNodeOccupied(*it)) continue;
+    const double res = tree_->getResolution();
+    const unsigned max_depth = tree_->getTreeDepth();
+    for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+      if (!tree_->isNodeOccupied(*it)) continue;
       const int n = 1 << (max_depth - it.getDepth());
       const octomap::point3d c = it.getCoordinate();
       const double h = it.getSize() / 2 - res / 2;
@@ -156,9 +169,12 @@ class OctomapBackend final : public MapBackend {
   }
 
   // The last keyframe's cells are applied when the map is next read, by const readers too.
-  mutable octomap::OcTree tree_;
+  std::unique_ptr<octomap::OcTree> tree_;
+  std::unique_ptr<const octomap::OcTree> loaded_;  ///< importMap()'s tree, of no keyframe
   octomap::OcTree caster_;  ///< casts rays only (its own key ray buffers), never holds a map
   mutable std::future<std::unique_ptr<Cells>> pending_;
+  double resolution_m_ = kDefaultResolutionM;
+  double prob_hit_ = 0.7, prob_miss_ = 0.4, clamp_min_ = 0.12, clamp_max_ = 0.97;
   double max_range_m_ = -1.0;
   bool discretize_ = true;
   plugin::GridOptions grid_;

@@ -3,7 +3,8 @@
 // its camera frame (keyframe_voxels.hpp); the map is those centroids placed by the keyframes'
 // current poses and merged by world voxel, at export. No whole-map structure lives between
 // exports: memory is the keyframes' reduced clouds (the newest resident_keyframes in RAM, the
-// others in a temporary file), and a pose update costs nothing.
+// others in a temporary file), and a pose update costs nothing. A saved map's cloud.ply
+// (importMap()) is one more block, in the world frame, of no keyframe.
 #include <array>
 #include <deque>
 #include <map>
@@ -38,25 +39,8 @@ class PclVoxelBackend final : public MapBackend {
   }
 
   void integrate(const KeyframeView& view) override {
-    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
-    const auto& pts = *view.points_C;
-    // Sort the keyframe's points by world voxel: the runs are its reduced cloud.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      keyed[i] = {plugin::voxelKey(T * pts[i], inv_voxel_), static_cast<std::uint32_t>(i)};
-    }
-    radixSortByKey(keyed, scratch_, [](const auto& k) { return k.first; });
-    std::vector<plugin::VoxelAccum> voxels_C;
-    for (std::size_t b = 0; b < keyed.size();) {
-      plugin::VoxelAccum run;
-      std::size_t e = b;
-      for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
-        run.add(pts[keyed[e].second], (*view.colors)[keyed[e].second].data());
-      }
-      voxels_C.push_back(run);
-      b = e;
-    }
-    keyframes_.insert_or_assign(view.id, Keyframe{view.T_W_C, plugin::KeyframeVoxels(voxels_C)});
+    keyframes_.insert_or_assign(
+        view.id, Keyframe{view.T_W_C, reduce(*view.points_C, *view.colors, view.T_W_C)});
     elements_.reset();
     spillOldKeyframes(view.id);
   }
@@ -72,6 +56,14 @@ class PclVoxelBackend final : public MapBackend {
     keyframes_.clear();
     resident_.clear();
     elements_.reset();
+  }
+  /// The saved cloud.ply's points fall back into their voxels, one block of no keyframe.
+  bool importMap(const std::string& dir) override {
+    const PlyData ply = plugin::loadCloudPly(dir);
+    const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+    loaded_.emplace(Keyframe{identity, reduce(ply.vertices, ply.colors, identity)});
+    elements_.reset();
+    return true;
   }
 
   void exportMap(const std::string& dir) override {
@@ -103,7 +95,7 @@ class PclVoxelBackend final : public MapBackend {
     s.keyframes = keyframes_.size();
     if (!elements_) elements_ = distinctVoxels();
     s.elements = *elements_;
-    for (const auto& kv : keyframes_) s.memory_bytes += kv.second.voxels.bytes();
+    forEachBlock([&s](const Keyframe& kf) { s.memory_bytes += kf.voxels.bytes(); });
     s.element_kind = "voxels";
     return s;
   }
@@ -113,6 +105,37 @@ class PclVoxelBackend final : public MapBackend {
     Eigen::Isometry3d T_W_C;
     plugin::KeyframeVoxels voxels;
   };
+
+  /// Points (camera frame) reduced to their world voxels' centroids, kept in the camera frame.
+  plugin::KeyframeVoxels reduce(const std::vector<Eigen::Vector3f>& pts,
+                                const std::vector<std::array<std::uint8_t, 3>>& colors,
+                                const Eigen::Isometry3d& T_W_C) {
+    const Eigen::Isometry3f T = T_W_C.cast<float>();
+    // Sort the points by world voxel: the runs are the reduced cloud.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      keyed[i] = {plugin::voxelKey(T * pts[i], inv_voxel_), static_cast<std::uint32_t>(i)};
+    }
+    radixSortByKey(keyed, scratch_, [](const auto& k) { return k.first; });
+    std::vector<plugin::VoxelAccum> voxels_C;
+    for (std::size_t b = 0; b < keyed.size();) {
+      plugin::VoxelAccum run;
+      std::size_t e = b;
+      for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
+        run.add(pts[keyed[e].second], colors[keyed[e].second].data());
+      }
+      voxels_C.push_back(run);
+      b = e;
+    }
+    return plugin::KeyframeVoxels(voxels_C);
+  }
+
+  /// The imported map, then the keyframes in id order.
+  template <typename F>
+  void forEachBlock(F&& f) const {
+    if (loaded_) f(*loaded_);
+    for (const auto& kv : keyframes_) f(kv.second);
+  }
 
   /// Beyond the newest resident_keyframes integrated, the oldest keyframe's voxels go to the
   /// spill file (0: all stay in RAM).
@@ -128,24 +151,24 @@ class PclVoxelBackend final : public MapBackend {
     }
   }
 
-  /// Calls f(world voxel key, centroid_W, rgb, count) for every keyframe voxel, keyframes in
-  /// id order.
+  /// Calls f(world voxel key, centroid_W, rgb, count) for every voxel of the imported map and
+  /// the keyframes (forEachBlock()'s order).
   template <typename F>
   void forEachPlacedVoxel(F&& f) const {
     std::vector<plugin::CompactVoxel> buffer;
-    for (const auto& kv : keyframes_) {
-      const Eigen::Isometry3f T = kv.second.T_W_C.cast<float>();
-      kv.second.voxels.forEach(
-          buffer, [&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb, std::uint32_t n) {
-            const Eigen::Vector3f p_W = T * p_C;
-            f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
-          });
-    }
+    forEachBlock([&](const Keyframe& kf) {
+      const Eigen::Isometry3f T = kf.T_W_C.cast<float>();
+      kf.voxels.forEach(buffer,
+                        [&](const Eigen::Vector3f& p_C, const std::uint8_t* rgb, std::uint32_t n) {
+                          const Eigen::Vector3f p_W = T * p_C;
+                          f(plugin::voxelKey(p_W, inv_voxel_), p_W, rgb, n);
+                        });
+    });
   }
 
   std::size_t placedVoxelCount() const {
     std::size_t n = 0;
-    for (const auto& kv : keyframes_) n += kv.second.voxels.size();
+    forEachBlock([&n](const Keyframe& kf) { n += kf.voxels.size(); });
     return n;
   }
 
@@ -203,7 +226,8 @@ class PclVoxelBackend final : public MapBackend {
   int resident_keyframes_ = 32;
   std::unique_ptr<plugin::SpillFile<plugin::CompactVoxel>> spill_;  ///< made at the first spill
   std::map<std::uint64_t, Keyframe> keyframes_;
-  std::deque<std::uint64_t> resident_;           ///< keyframes in RAM, oldest first
+  std::optional<Keyframe> loaded_;      ///< importMap()'s voxels (world frame), of no keyframe
+  std::deque<std::uint64_t> resident_;  ///< keyframes in RAM, oldest first
   mutable std::optional<std::size_t> elements_;  ///< distinct voxels, until the map changes
 };
 

@@ -1,5 +1,6 @@
 // `points`: raw stitching of keyframe clouds. Keeps each keyframe's static points in the camera
-// frame, so pose updates only change the stored pose; export transforms and concatenates.
+// frame, so pose updates only change the stored pose; export transforms and concatenates. A
+// saved map's cloud.ply (importMap()) is kept in the world frame beside them.
 #include <unordered_map>
 
 #include "dynamap/mapping/backend_params.hpp"
@@ -38,19 +39,27 @@ class PointsBackend final : public MapBackend {
   void reset() override {
     keyframes_.clear();
     order_.clear();
-    total_points_ = 0;
+    total_points_ = loaded_.points_C.size();
+  }
+  bool importMap(const std::string& dir) override {
+    PlyData ply = plugin::loadCloudPly(dir);
+    total_points_ = total_points_ - loaded_.points_C.size() + ply.vertices.size();
+    loaded_.points_C = std::move(ply.vertices);  // world frame: the identity pose
+    loaded_.colors = std::move(ply.colors);
+    return true;
   }
 
   void exportMap(const std::string& dir) override {
     pcl::PointCloud<pcl::PointXYZRGB> cloud;
     cloud.reserve(total_points_);
-    for (const std::uint64_t id : order_) {
-      const Keyframe& kf = keyframes_.at(id);
+    const auto append = [&cloud](const Keyframe& kf) {
       const Eigen::Isometry3f T = kf.T_W_C.cast<float>();
       for (std::size_t i = 0; i < kf.points_C.size(); ++i) {
         cloud.push_back(plugin::makePoint(T * kf.points_C[i], kf.colors[i]));
       }
-    }
+    };
+    append(loaded_);
+    for (const std::uint64_t id : order_) append(keyframes_.at(id));
     plugin::saveCloudPlyPcd(cloud, dir);
   }
 
@@ -65,13 +74,14 @@ class PointsBackend final : public MapBackend {
 
  private:
   struct Keyframe {
-    Eigen::Isometry3d T_W_C;
+    Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
     std::vector<Eigen::Vector3f> points_C;
     std::vector<std::array<std::uint8_t, 3>> colors;
   };
   int keep_every_ = 1;
   std::unordered_map<std::uint64_t, Keyframe> keyframes_;
   std::vector<std::uint64_t> order_;
+  Keyframe loaded_;  ///< importMap()'s points, of no keyframe
   std::size_t total_points_ = 0;
 };
 

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 
-#include <openvdb/io/File.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
@@ -174,11 +173,19 @@ TsdfVolume::TsdfVolume(const TsdfOptions& options) : options_(options) {
 }
 
 void TsdfVolume::reset() {
+  if (loaded_.tsdf) {
+    tsdf_ = loaded_.tsdf->deepCopy();
+    weight_ = loaded_.weight->deepCopy();
+    color_ = loaded_.color->deepCopy();
+    free_ = loaded_.free->deepCopy();
+    return;
+  }
   const auto transform = openvdb::math::Transform::createLinearTransform(options_.voxel_size_m);
   tsdf_ = openvdb::FloatGrid::create(1.0f);
   tsdf_->setTransform(transform);
   tsdf_->setName("tsdf");
   tsdf_->setGridClass(openvdb::GRID_LEVEL_SET);
+  tsdf_->insertMeta("truncation_m", openvdb::DoubleMetadata(options_.truncation_m));
   weight_ = openvdb::FloatGrid::create(0.0f);
   weight_->setTransform(transform->copy());
   weight_->setName("weight");
@@ -188,6 +195,11 @@ void TsdfVolume::reset() {
   free_ = openvdb::FloatGrid::create(0.0f);
   free_->setTransform(transform->copy());
   free_->setName("free_views");
+}
+
+void TsdfVolume::importVdb(const std::string& path) {
+  loaded_ = readVdb(path);
+  reset();
 }
 
 // free_ holds, per voxel, the views that saw through it minus free_vote_ratio x the band weight
@@ -279,16 +291,13 @@ void TsdfVolume::integrate(const PinholeCamera& camera, const cv::Mat& depth_m, 
 }
 
 std::size_t TsdfVolume::memoryBytes() const {
-  return tsdf_->memUsage() + weight_->memUsage() + color_->memUsage() + free_->memUsage();
-}
-
-void TsdfVolume::writeVdb(const std::string& path,
-                          const openvdb::FloatGrid::ConstPtr& voted) const {
-  openvdb::GridCPtrVec grids{voted, weight_, color_};
-  if (options_.free_votes) grids.push_back(free_);
-  openvdb::io::File file(path);
-  file.write(grids);
-  file.close();
+  std::size_t bytes =
+      tsdf_->memUsage() + weight_->memUsage() + color_->memUsage() + free_->memUsage();
+  if (loaded_.tsdf) {  // kept for reset()
+    bytes += loaded_.tsdf->memUsage() + loaded_.weight->memUsage() + loaded_.color->memUsage() +
+             loaded_.free->memUsage();
+  }
+  return bytes;
 }
 
 }  // namespace dynamap::plugin

@@ -32,6 +32,12 @@ struct TsdfOptions {
   float free_vote_ratio = 0.5f;
 };
 
+/// "crc32 <8 hex digits> bytes <n>" of the file at `path` (zlib's crc32). Written beside
+/// tsdf.vdb as tsdf.vdb.crc32 and checked before OpenVDB parses the file: a length in a damaged
+/// header makes OpenVDB allocate what it says (4 GB). Throws MappingError naming the file.
+std::string fileDigest(const std::string& path);
+inline constexpr const char* kDigestSuffix = ".crc32";
+
 /// A colour TSDF in OpenVDB grids (tsdf normalised to [-1, 1], weight = views within the
 /// truncation band, colour, and with free_votes the see-through votes), integrated
 /// projectively: the 8^3 leaf blocks within the truncation band of the observed depth (and, with
@@ -43,18 +49,34 @@ class TsdfVolume {
   explicit TsdfVolume(const TsdfOptions& options);
   void integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
                  const Eigen::Isometry3d& T_W_C);
+  /// Back to the imported grids (importVdb()), or empty.
   void reset();
+  /// Starts from the grids writeVdb() wrote to `path`, which reset() then comes back to. Checked
+  /// first (tsdf_volume_io.cpp): the file against its digest `path`.crc32 where there is one
+  /// (maps saved before it have none), grids tsdf, weight and color (free_views optional) of their
+  /// types and backgrounds, this volume's voxel size and unshifted transform, its truncation_m
+  /// where recorded, values finite and in range. Throws MappingError "<path>: <field>: <what>"
+  /// and leaves the volume as it was.
+  void importVdb(const std::string& path);
   /// tsdf with the voxels the free votes carve set to +1 (the tsdf itself without free_votes):
   /// what both exports read, made once per export.
   openvdb::FloatGrid::ConstPtr votedTsdf() const;
   /// Marching cubes (openvdb::tools::volumeToMesh) of `voted` keeping cells whose 8 corners are
   /// observed.
   PlyData extractMesh(const openvdb::FloatGrid& voted) const;
+  /// The grids `voted` (named tsdf), weight, color and, with free votes, free_views.
   void writeVdb(const std::string& path, const openvdb::FloatGrid::ConstPtr& voted) const;
   std::size_t activeVoxels() const { return tsdf_->activeVoxelCount(); }
   std::size_t memoryBytes() const;
 
  private:
+  /// The volume's grids; loaded_'s are those importVdb() read (tsdf null: none).
+  struct Grids {
+    openvdb::FloatGrid::Ptr tsdf, weight, free;
+    openvdb::Vec3SGrid::Ptr color;
+  };
+  /// writeVdb()'s grids at `path`, checked against options_ (tsdf_volume_io.cpp).
+  Grids readVdb(const std::string& path) const;
   std::vector<openvdb::Coord> collectBlocks(const PinholeCamera& camera, const cv::Mat& depth_m,
                                             const Eigen::Isometry3d& T_W_C) const;
   TsdfOptions options_;
@@ -64,6 +86,7 @@ class TsdfVolume {
   /// free_votes: the views that saw through each voxel, less free_vote_ratio x the band weight
   /// that max_weight cut off (see votedTsdf()).
   openvdb::FloatGrid::Ptr free_;
+  Grids loaded_;
 };
 
 }  // namespace dynamap::plugin

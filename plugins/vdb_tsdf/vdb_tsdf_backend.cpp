@@ -1,8 +1,11 @@
 // `vdb_tsdf`: OpenVDB colour TSDF with projective integration and space carving
-// (tsdf_volume.hpp). Exports mesh.ply, mesh.obj and tsdf.vdb. Pose updates: the mapping worker
-// rebuilds the volume with the final poses (PoseUpdateMode::kReintegrate).
+// (tsdf_volume.hpp). Exports mesh.ply, mesh.obj, tsdf.vdb and its digest tsdf.vdb.crc32. Pose
+// updates: the mapping worker rebuilds the volume with the final poses
+// (PoseUpdateMode::kReintegrate). A saved map's tsdf.vdb (importMap()) is the volume's start, to
+// which each rebuild's reset() returns.
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -55,6 +58,10 @@ class VdbTsdfBackend final : public MapBackend {
     volume_.reset();
     keyframes_ = 0;
   }
+  bool importMap(const std::string& dir) override {
+    volume_.importVdb((std::filesystem::path(dir) / "tsdf.vdb").string());
+    return true;
+  }
 
   void exportMap(const std::string& dir) override {
     namespace fs = std::filesystem;
@@ -74,8 +81,11 @@ class VdbTsdfBackend final : public MapBackend {
     };
     std::exception_ptr vdb_error, obj_error;
     std::thread vdb = on_thread(vdb_error, [&] {
-      writeAtomically((d / "tsdf.vdb").string(),
-                      [&](const std::string& tmp) { volume_.writeVdb(tmp, voted); });
+      const std::string vdb_path = (d / "tsdf.vdb").string();
+      writeAtomically(vdb_path, [&](const std::string& tmp) { volume_.writeVdb(tmp, voted); });
+      writeAtomically(vdb_path + plugin::kDigestSuffix, [&](const std::string& tmp) {
+        std::ofstream(tmp) << plugin::fileDigest(vdb_path) << "\n";
+      });
     });
     PlyData mesh;  // outlives every thread that reads it, also when a write throws
     std::thread obj;

@@ -167,6 +167,7 @@ PYBIND11_MODULE(dynamap, m) {
             d["mapped_keyframes"] = c.mapped_keyframes;
             d["map_elements"] = c.map_elements;
             d["loaded_keyframes"] = c.loaded_keyframes;
+            d["loaded_map_elements"] = c.loaded_map_elements;
             return d;
           },
           "Frame and keyframe counts so far (dict).");

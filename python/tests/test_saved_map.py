@@ -19,6 +19,7 @@ def test_reload_poses_in_the_saved_frame(teddy, tmp_path):
     assert (tmp_path / "saved" / "map.sqlite").is_file()
     saved_poses = {round(t, 6): pose for t, pose in first.trajectory()}
     saved_keyframes = first.counts["keyframes"]
+    saved_elements = first.counts["map_elements"]
 
     # The same frames backward, 100 s later: poses of the same images in run 1's frame.
     second = dynamap.System(overrides=FAST, load_map=str(tmp_path / "saved"))
@@ -27,6 +28,7 @@ def test_reload_poses_in_the_saved_frame(teddy, tmp_path):
     second.finish()
     counts = second.counts
     assert counts["loaded_keyframes"] == saved_keyframes
+    assert counts["loaded_map_elements"] >= 0.98 * saved_elements  # the saved voxels, re-placed
     assert counts["lost"] <= 2  # relocalized within the first frames, then tracked
     errors = [np.linalg.norm(pose[:3, 3] - saved_poses[round(t - 100.0, 6)][:3, 3])
               for t, pose in second.trajectory()]

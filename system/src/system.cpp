@@ -11,7 +11,6 @@
 #include "dynamap/mapping/backend_registry.hpp"
 #include "dynamap/mapping/mapping_worker.hpp"
 #include "dynamap/mapping/mask_lookahead.hpp"
-#include "dynamap/mapping/ply_io.hpp"
 #include "dynamap/system/map_store.hpp"
 #include "frame_input.hpp"
 #include "plugin_paths.hpp"
@@ -40,7 +39,7 @@ struct System::Impl {
   int pending_seen = 0;
   std::vector<KeyframePacketPtr> last_mapped;  // released by finish()
 
-  /// SystemOptions::load_map_dir: the tracker's map, and the points for a point backend.
+  /// SystemOptions::load_map_dir: the tracker's map, and the backend's if it made the map.
   void loadMap(const std::string& dir);
   void pushKeyframe(KeyframePacketPtr kf);
   /// Adds what `frame`'s mask covers to the waiting keyframe's mask; hands it to the mapper
@@ -53,12 +52,18 @@ struct System::Impl {
 void System::Impl::loadMap(const std::string& dir) {
   ScopedStageTimer timer(timings, "map_load");
   const std::filesystem::path folder(dir);
-  MapContents contents = readMapStore((folder / kMapStoreFile).string(), camera);
+  MapStoreInfo info;
+  MapContents contents = readMapStore((folder / kMapStoreFile).string(), camera, &info);
   counts.loaded_keyframes = contents.keyframes.size();
-  const std::filesystem::path cloud = folder / "map" / "cloud.ply";
-  if (std::filesystem::exists(cloud)) {
-    const PlyData ply = readPly(cloud.string());
-    if (mapper->importPoints(ply.vertices, ply.colors)) counts.loaded_map_points = ply.vertices.size();
+  // The dense map is the saved backend's files: another backend starts without it.
+  if (info.backend == backend_name) {
+    try {
+      if (mapper->importMap((folder / "map").string())) {
+        counts.loaded_map_elements = mapper->stats().elements;
+      }
+    } catch (const MappingError& e) {  // a saved file: the map's error, as the store's are
+      throw MapFileError(e.what());
+    }
   }
   tracker->loadMap(std::move(contents));
 }

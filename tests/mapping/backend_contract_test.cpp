@@ -89,7 +89,7 @@ void expectExportsLoad(const std::string& name, const fs::path& dir) {
   const std::map<std::string, std::vector<std::string>> expected = {
       {"points", {"cloud.ply", "cloud.pcd"}},
       {"pcl_voxel", {"cloud.ply", "cloud.pcd"}},
-      {"vdb_tsdf", {"mesh.ply", "mesh.obj", "tsdf.vdb"}},
+      {"vdb_tsdf", {"mesh.ply", "mesh.obj", "tsdf.vdb", "tsdf.vdb.crc32"}},
       {"octomap", {"map.bt", "map.ot", "grid.pgm", "grid.yaml", "cloud.ply"}},
   };
   if (expected.count(name)) {

@@ -1,12 +1,16 @@
 // Save and reload (issue 47, point 4): a second run started in a saved map relocalizes in it
 // within the first frames, reports poses in the saved map's frame, reuses its keyframes and
-// extends its dense map; a bad map is one MapFileError before anything runs.
+// extends its dense map, whichever backend made it; a bad map is one MapFileError before
+// anything runs.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
+#include "dynamap/mapping/backend_registry.hpp"
+#include "dynamap/mapping/ply_io.hpp"
 #include "dynamap/system.hpp"
 #include "dynamap/system/map_store.hpp"
 #include "synthetic_scene.hpp"
@@ -70,14 +74,18 @@ double rms(const std::vector<double>& v) {
   return v.empty() ? INFINITY : std::sqrt(sum2 / v.size());
 }
 
+std::vector<int> walkFrames(bool forward) {
+  std::vector<int> order;
+  for (int i = 0; i < kFrames; ++i) order.push_back(forward ? i : kFrames - 1 - i);
+  return order;
+}
+
 TEST(SavedMap, ReloadRelocalizesInTheSavedFrameAndExtendsTheMap) {
   const AppConfig config = savedMapConfig();
   test::SyntheticScene scene(config.resolvedCamera(), 21);
   scene.addDefaultRoom();
   const auto dir = test::freshTempDir("saved_map_reload");
-  std::vector<int> forward, backward;
-  for (int i = 0; i < kFrames; ++i) forward.push_back(i);
-  for (int i = kFrames - 1; i >= 0; --i) backward.push_back(i);
+  const std::vector<int> forward = walkFrames(true), backward = walkFrames(false);
 
   System first(config);
   const RunOutcome run1 = runWalk(first, scene, forward, 0.0);
@@ -100,6 +108,8 @@ TEST(SavedMap, ReloadRelocalizesInTheSavedFrameAndExtendsTheMap) {
       run1.counts.keyframes, run1.counts.map_elements, 1e3 * rms(run1.errors_m), first_posed,
       1e3 * rms(run2.errors_m), run2.counts.keyframes, run2.counts.map_elements);
   EXPECT_EQ(run2.counts.loaded_keyframes, run1.counts.keyframes);
+  EXPECT_NEAR(static_cast<double>(run2.counts.loaded_map_elements), run1.counts.map_elements,
+              0.02 * run1.counts.map_elements);
   EXPECT_LE(first_posed, 2u);                // relocalized in the first frames
   EXPECT_EQ(run2.counts.lost, first_posed);  // and never lost after that
   // In run 1's frame without any alignment: as accurate as run 1 itself (< 1 cm RMS there).
@@ -125,6 +135,93 @@ TEST(SavedMap, BadMapIsOneErrorBeforeAnythingRuns) {
         << e.what();
   }
 }
+
+/// The exported map's vertices: the mesh's (vdb_tsdf) or the cloud's (octomap: cell centres).
+std::size_t exportedVertices(const std::filesystem::path& dir) {
+  const auto mesh = dir / "mesh.ply";
+  return readPly((std::filesystem::exists(mesh) ? mesh : dir / "cloud.ply").string())
+      .vertices.size();
+}
+
+/// The volumetric backends start from their saved volume (tsdf.vdb, map.ot), not from nothing.
+class SavedMapVolume : public ::testing::TestWithParam<std::string> {
+ protected:
+  AppConfig config() const {
+    AppConfig c = savedMapConfig();
+    c.mapping.backend = GetParam();
+    // Coarser than the defaults (0.02 / 0.03 m): the test's runtime is the ray casting's.
+    c.mapping.params["vdb_tsdf.voxel_size_m"] = "0.04";
+    c.mapping.params["octomap.resolution_m"] = "0.06";
+    return c;
+  }
+};
+
+TEST_P(SavedMapVolume, ReloadStartsFromTheSavedVolume) {
+  const AppConfig config = this->config();
+  test::SyntheticScene scene(config.resolvedCamera(), 21);
+  scene.addDefaultRoom();
+  const auto dir = test::freshTempDir("saved_volume_" + GetParam());
+  System first(config);
+  const RunOutcome run1 = runWalk(first, scene, walkFrames(true), 0.0);
+  first.saveMap(dir.string());
+  const std::size_t saved = exportedVertices(dir / "map");
+  ASSERT_GT(saved, 1000u);
+
+  SystemOptions unchanged_options;  // reloaded, no frame, exported again
+  unchanged_options.load_map_dir = dir.string();
+  System unchanged(config, std::move(unchanged_options));
+  unchanged.exportMap((dir / "again").string());
+  const std::size_t again = exportedVertices(dir / "again");
+
+  SystemOptions options;  // the walk backward on the saved map
+  options.load_map_dir = dir.string();
+  System second(config, std::move(options));
+  const RunOutcome run2 = runWalk(second, scene, walkFrames(false), 100.0);
+  std::printf(
+      "%s: run 1 %zu elements, %zu exported; reloaded %zu, %zu; run 2 %zu (%zu new "
+      "keyframes)\n",
+      GetParam().c_str(), run1.counts.map_elements, saved, unchanged.counts().map_elements, again,
+      run2.counts.map_elements, run2.counts.keyframes);
+  EXPECT_EQ(unchanged.counts().mapped_keyframes, 0u);  // the saved volume is no keyframe
+  EXPECT_EQ(unchanged.counts().loaded_map_elements, run1.counts.map_elements);
+  EXPECT_NEAR(static_cast<double>(again), saved, 0.01 * saved);  // the same surface / cells
+  // The walk backward sees what run 1 saw: run 1's map and few new elements (without the saved
+  // volume: only the few new keyframes' view).
+  EXPECT_GE(run2.counts.map_elements, 0.98 * run1.counts.map_elements);
+  EXPECT_LE(run2.counts.map_elements, 1.15 * run1.counts.map_elements);
+}
+
+TEST_P(SavedMapVolume, CorruptVolumeIsOneErrorNamingTheFileBeforeAnythingRuns) {
+  const AppConfig config = this->config();
+  test::SyntheticScene scene(config.resolvedCamera(), 21);
+  scene.addDefaultRoom();
+  const auto dir = test::freshTempDir("saved_volume_bad_" + GetParam());
+  System first(config);
+  runWalk(first, scene, {0, 1, 2, 3, 4, 5}, 0.0);
+  first.saveMap(dir.string());
+  const auto file = dir / "map" / (GetParam() == "vdb_tsdf" ? "tsdf.vdb" : "map.ot");
+  std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
+  SystemOptions options;
+  options.load_map_dir = dir.string();
+  try {
+    System system(config, std::move(options));
+    FAIL() << "a truncated " << file << " was accepted";
+  } catch (const MapFileError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(file.string() + ": ", 0), 0u) << e.what();
+  }
+}
+
+std::vector<std::string> volumeBackends() {
+  std::vector<std::string> out;
+  for (const auto& name : BackendRegistry::scan({(test::binaryDir() / "lib").string()}).names()) {
+    if (name == "vdb_tsdf" || name == "octomap") out.push_back(name);
+  }
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Volumes, SavedMapVolume, ::testing::ValuesIn(volumeBackends()),
+                         [](const auto& info) { return info.param; });
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SavedMapVolume);
 
 }  // namespace
 }  // namespace dynamap

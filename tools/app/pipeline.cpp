@@ -333,6 +333,7 @@ void Pipeline::finalize(RunResult& result) {
   result.counts.mapped_keyframes = counts.mapped_keyframes;
   result.counts.mapper_dropped = counts.mapper_dropped;
   result.counts.loaded_keyframes = counts.loaded_keyframes;
+  result.counts.loaded_map_elements = counts.loaded_map_elements;
   result.map_dir = (fs::path(options_.out_dir) / "map").string();
   system.exportMap(result.map_dir);
   if (!options_.save_map_dir.empty()) system.saveMap(options_.save_map_dir);  // after the outputs

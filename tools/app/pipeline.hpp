@@ -32,6 +32,8 @@ struct RunCounts {
   std::size_t skipped_realtime = 0;  ///< --realtime: frames skipped because tracking lagged
   std::size_t mapper_dropped = 0;    ///< --realtime: keyframes the busy mapper did not take
   std::size_t loaded_keyframes = 0;  ///< --load-map: the saved map's (keyframes: this run's new)
+  /// --load-map: the saved dense map's elements (0 when another backend saved it)
+  std::size_t loaded_map_elements = 0;
 };
 
 /// What a run produced; filled even when it stops early.

@@ -77,7 +77,10 @@ void writeRunJson(const std::string& out_dir, const RunResult& result) {
                  {"mapped_keyframes", c.mapped_keyframes},
                  {"skipped_realtime", c.skipped_realtime},
                  {"mapper_dropped", c.mapper_dropped}};
-  if (c.loaded_keyframes > 0) counts["loaded_keyframes"] = c.loaded_keyframes;  // --load-map
+  if (c.loaded_keyframes > 0) {  // --load-map
+    counts["loaded_keyframes"] = c.loaded_keyframes;
+    counts["loaded_map_elements"] = c.loaded_map_elements;
+  }
   Json root = {{"status", result.status},
                {"mode", result.mode},
                {"counts", counts},

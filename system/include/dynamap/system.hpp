@@ -44,10 +44,11 @@ struct SystemCounts {
   std::size_t map_elements = 0;  ///< the backend's points, voxels or cells so far
 
   std::size_t mapper_dropped = 0;  ///< SystemOptions::drop_keyframes_when_busy only
-  /// From SystemOptions::load_map_dir: keyframes and points the run started with (`keyframes`
-  /// counts only this run's new ones).
+  /// From SystemOptions::load_map_dir: keyframes the run started with (`keyframes` counts only
+  /// this run's new ones) and the saved dense map's points, voxels or cells (0 when the map was
+  /// made with another backend: the run starts with the tracker's map only).
   std::size_t loaded_keyframes = 0;
-  std::size_t loaded_map_points = 0;
+  std::size_t loaded_map_elements = 0;
 };
 
 /// How a System is wired beyond the typed configuration.
@@ -70,10 +71,11 @@ struct SystemOptions {
   int mapping_thread_nice = 19;
   /// Start in the map that saveMap() wrote into this folder (empty = a new map): the tracker
   /// relocalizes in it within the first frames (lost until then), poses are in its frame and new
-  /// keyframes extend it; point backends (`points`, `pcl_voxel`) start with its points, the
-  /// volumetric ones with the new keyframes only. A missing, corrupt or mismatched map (other
-  /// camera, other format version) makes the constructor throw MapFileError naming the file
-  /// and field. Not with given_poses.
+  /// keyframes extend it; the backend that made it starts from its dense map (MapBackend::
+  /// importMap(): `points` / `pcl_voxel` its cloud, `vdb_tsdf` its grids, `octomap` its tree),
+  /// another backend with the new keyframes only. A missing, corrupt or mismatched map (other
+  /// camera, other format version, a volume of another voxel size) makes the constructor throw
+  /// MapFileError naming the file and field. Not with given_poses.
   std::string load_map_dir;
   /// Where every stage records its timings (borrowed; must outlive the System). Null = the
   /// System keeps its own (timings()).

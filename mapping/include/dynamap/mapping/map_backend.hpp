@@ -61,7 +61,8 @@ class MapBackend {
   /// A corrected pose for an integrated keyframe (unknown ids are ignored).
   virtual void updatePose(std::uint64_t keyframe_id, const Eigen::Isometry3d& T_W_C) = 0;
   virtual PoseUpdateMode poseUpdateMode() const = 0;
-  /// Drops all content (the worker re-integrates every keyframe after it).
+  /// Drops every keyframe's content (the worker re-integrates every keyframe after it); a map
+  /// taken by importMap() stays.
   virtual void reset() = 0;
   /// Writes the map files into `dir` (created if missing) under stable names, atomically.
   /// Throws MappingError on I/O failure.
@@ -74,6 +75,16 @@ class MapBackend {
   /// false: integrate() reads only `static_depth_m` and `bgr`, and the worker leaves `points_C`
   /// and `colors` empty (a TSDF projects its voxels into the depth image; no points needed).
   virtual bool needsPoints() const { return true; }
+  /// Starts from the map that exportMap() wrote into `dir` (world frame), before any keyframe:
+  /// that content belongs to no keyframe (no updatePose() moves it, reset() keeps it,
+  /// stats().keyframes leaves it out) and keyframes integrate on top of it. Returns false if the
+  /// backend cannot take a saved map (nothing changed). A missing, corrupt or mismatched file
+  /// (e.g. another voxel size) throws MappingError "<file>: <field>: <what>" and leaves the
+  /// backend as it was.
+  virtual bool importMap(const std::string& dir) {
+    (void)dir;
+    return false;
+  }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).
@@ -82,7 +93,8 @@ using BackendParams = std::map<std::string, std::string>;
 /// The one symbol a plugin exports (see plugin_api.hpp). Returns a new backend owned by the
 /// caller; throws MappingError for a bad parameter.
 using BackendFactoryFn = MapBackend* (*)(const BackendParams& params);
-/// v2: MapBackend::needsPoints() (a plugin built for v1 has a shorter vtable: refused by name).
-inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v2";
+/// v2: MapBackend::needsPoints(); v3: MapBackend::importMap() (a plugin built for an older
+/// version has a shorter vtable: refused by name).
+inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v3";
 
 }  // namespace dynamap

@@ -40,8 +40,6 @@ class MappingWorker {
   static constexpr double kReintegrateTranslationM = 0.01;
   static constexpr double kReintegrateRotationRad = 0.5 * 3.14159265358979 / 180.0;
   static constexpr std::uint64_t kSupplementBit = std::uint64_t{1} << 63;
-  /// The backend's id of a saved map's points (importPoints()); no keyframe has it.
-  static constexpr std::uint64_t kLoadedMapId = std::uint64_t{1} << 62;
 
   MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
                 const StaticPointsOptions& options, std::size_t queue_capacity,
@@ -50,12 +48,11 @@ class MappingWorker {
   MappingWorker(const MappingWorker&) = delete;
   MappingWorker& operator=(const MappingWorker&) = delete;
 
-  /// A saved map's points (world frame, RGB colours) as the backend's first content, under
-  /// kLoadedMapId: pose updates never move them, new keyframes add to them. Only for backends
-  /// that keep points (kInPlace and needsPoints(): `points`, `pcl_voxel`); returns false and
-  /// does nothing for the others. Call before the first push().
-  bool importPoints(const std::vector<Eigen::Vector3f>& p_W,
-                    const std::vector<std::array<std::uint8_t, 3>>& colors);
+  /// The map a backend of this kind exported into `dir` as the backend's first content
+  /// (MapBackend::importMap(): pose updates never move it, a rebuild keeps it, new keyframes add
+  /// to it). Returns false if the backend cannot take a saved map; throws MappingError naming the
+  /// file and the field for a missing, corrupt or mismatched one. Call before the first push().
+  bool importMap(const std::string& dir);
   /// Blocks while the queue is full.
   void push(KeyframePacketPtr kf);
   /// Non-blocking; returns false (and counts a drop) when the queue is full.
@@ -190,7 +187,7 @@ class MappingWorker {
   std::vector<std::uint64_t> revisit_;  ///< online: keyframes whose view is kept for revisits
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
-  /// Held second looks and an imported map in the backend (not counted as keyframes).
+  /// Held second looks in the backend (not counted as keyframes).
   std::size_t supplements_ = 0;
   VisibilityResult visibility_;
   std::unordered_map<std::uint64_t, cv::Mat> revised_masks_;
