@@ -24,6 +24,7 @@ DATA = os.path.join(SHARED, "data")
 CASES = {
     "teddy": (f"{DATA}/tum/rgbd_dataset_freiburg3_teddy", 200, []),
     "crowd": (f"{DATA}/dynamic/teddy_dyn_crowd_dev", 200, []),
+    "dyn": (f"{DATA}/dynamic/teddy_dyn_dev", 200, []),
     "bonn": (f"{DATA}/bonn/rgbd_bonn_crowd_400_499", 100, ["--config", "config/bonn.yaml"]),
 }
 

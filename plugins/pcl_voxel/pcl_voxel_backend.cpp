@@ -178,9 +178,9 @@ class PclVoxelBackend final : public MapBackend {
   std::vector<plugin::VoxelAccum> mergedVoxels() const {
     std::array<std::vector<plugin::VoxelAccum>, kMergeHalves> merged;
     tbb::parallel_for(0, kMergeHalves, [&](int half) {
-      FlatIndex index(expectedVoxels() / kMergeHalves);
+      FlatIndex index(expectedVoxels());
       std::vector<plugin::VoxelAccum>& out = merged[static_cast<std::size_t>(half)];
-      out.reserve(expectedVoxels() / kMergeHalves);
+      out.reserve(expectedVoxels());
       forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f& p_W, const std::uint8_t* rgb,
                              std::uint32_t n) {
         if (halfOf(key) != half) return;
@@ -198,7 +198,7 @@ class PclVoxelBackend final : public MapBackend {
   std::size_t distinctVoxels() const {
     std::array<std::size_t, kMergeHalves> count{};
     tbb::parallel_for(0, kMergeHalves, [&](int half) {
-      FlatIndex index(expectedVoxels() / kMergeHalves);
+      FlatIndex index(expectedVoxels());
       forEachPlacedVoxel(
           [&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*, std::uint32_t) {
             if (halfOf(key) == half) index.tryEmplace(key, 0);
@@ -214,8 +214,12 @@ class PclVoxelBackend final : public MapBackend {
   static int halfOf(std::uint64_t key) {
     return static_cast<int>((key * 0x9E3779B97F4A7C15ull) >> 63);  // Fibonacci hash, top bit
   }
-  /// The map's distinct voxels if known, else half the placed ones.
-  std::size_t expectedVoxels() const { return elements_ ? *elements_ : placedVoxelCount() / 2; }
+  /// Distinct voxels expected in one half (5 % margin): the map's if known, else 2/3 of the
+  /// placed ones. Too few costs a regrowth of the half's index and voxels.
+  std::size_t expectedVoxels() const {
+    const std::size_t all = elements_ ? *elements_ : placedVoxelCount() * 2 / 3;
+    return all / kMergeHalves + all / 20;
+  }
 
   double voxel_size_m_ = 0.01;
   float inv_voxel_ = 100.0f;
