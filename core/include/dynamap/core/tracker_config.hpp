@@ -91,10 +91,10 @@ struct TrackerConfig {
   /// outside the static views of the keyframes near it: a new keyframe adds that to the map
   /// (static scene the old ones had masked, or had not seen).
   double kf_reuse_max_uncovered_share = 0.05;
-  /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere
-  /// (the newest keyframes are tracked anyway). Views of movers from several times come from
-  /// the coverage test above.
-  double kf_reuse_min_age_s = 1.5;
+  /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
+  /// At 1.5 teddy x10 made 82 keyframes instead of ~96, but crowd x10 ran away in its last
+  /// pass (54 keyframes, 1.05 -> 2.14 cm; at 5: 89 keyframes, 1.04 cm).
+  double kf_reuse_min_age_s = 5.0;
   /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
   /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
   /// third of the landmarks in view (teddy x10: 144 keyframes; 3000 at 7: 96).
