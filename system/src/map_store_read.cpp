@@ -42,9 +42,7 @@ class Reader {
     sqlite3_stmt* s = stmt.get();
     while (db_.step(s, "table landmarks")) {
       const std::string row = "landmarks row " + std::to_string(out.size());
-      if (sqlite3_column_int64(s, 0) != static_cast<sqlite3_int64>(out.size())) {
-        bad(row, "field id is not " + std::to_string(out.size()) + " (ids must be dense)");
-      }
+      expectDenseId(s, out.size(), row);
       Landmark lm;
       for (int k = 0; k < 3; ++k) lm.p_W[k] = sqlite3_column_double(s, 1 + k);
       if (!lm.p_W.allFinite()) bad(row, "field x/y/z is not finite");
@@ -72,9 +70,7 @@ class Reader {
       const std::string row = "keyframes row " + std::to_string(out.size());
       MapKeyframe kf;
       kf.id = out.size();
-      if (sqlite3_column_int64(s, 0) != static_cast<sqlite3_int64>(kf.id)) {
-        bad(row, "field id is not " + std::to_string(kf.id) + " (ids must be dense)");
-      }
+      expectDenseId(s, kf.id, row);
       kf.timestamp_s = sqlite3_column_double(s, 1);
       const Eigen::Vector3d t(sqlite3_column_double(s, 2), sqlite3_column_double(s, 3),
                               sqlite3_column_double(s, 4));
@@ -98,6 +94,13 @@ class Reader {
   }
 
  private:
+  /// Column 0 of the row must be `expected`: ids are dense, landmarks[i] has id i.
+  void expectDenseId(sqlite3_stmt* s, std::size_t expected, const std::string& row) {
+    if (sqlite3_column_int64(s, 0) != static_cast<sqlite3_int64>(expected)) {
+      bad(row, "field id is not " + std::to_string(expected) + " (ids must be dense)");
+    }
+  }
+
   std::vector<KeyframeObservation> observations(sqlite3_stmt* s, int column,
                                                 std::size_t landmark_count,
                                                 const std::string& row) const {
