@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "dynamap/mapping/flat_index.hpp"
-#include "in_two.hpp"
+#include "dynamap/mapping/in_two.hpp"
 #include "visibility_table.hpp"
 
 namespace dynamap {

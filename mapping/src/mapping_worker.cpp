@@ -10,7 +10,7 @@
 #include <unistd.h>
 #endif
 
-#include "in_two.hpp"
+#include "dynamap/mapping/in_two.hpp"
 
 namespace dynamap {
 namespace {

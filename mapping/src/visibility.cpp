@@ -12,7 +12,7 @@
 
 #include "dynamap/mapping/radix_sort.hpp"
 #include "dynamap/mapping/static_points.hpp"
-#include "in_two.hpp"
+#include "dynamap/mapping/in_two.hpp"
 #include "visibility_table.hpp"
 
 namespace dynamap {

@@ -12,10 +12,10 @@
 #include <optional>
 
 #include <pcl/filters/statistical_outlier_removal.h>
-#include <tbb/parallel_for.h>
 
 #include "dynamap/mapping/backend_params.hpp"
 #include "dynamap/mapping/flat_index.hpp"
+#include "dynamap/mapping/in_two.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
 #include "dynamap/mapping/radix_sort.hpp"
 #include "keyframe_voxels.hpp"
@@ -173,11 +173,12 @@ class PclVoxelBackend final : public MapBackend {
   }
 
   /// The map: every keyframe's voxels at its current pose, merged by world voxel. Two halves
-  /// of the world's voxels (by a hash of the key) are merged at once on two threads, each in
-  /// the order of their first keyframe, the first half first.
+  /// of the world's voxels (by a hash of the key) are merged at once on two threads (inTwo),
+  /// each in the order of their first keyframe, the first half first. (With TBB here the reload
+  /// tests ran ~500 x slower under TSan than in Release; `points` ~20 x.)
   std::vector<plugin::VoxelAccum> mergedVoxels() const {
     std::array<std::vector<plugin::VoxelAccum>, kMergeHalves> merged;
-    tbb::parallel_for(0, kMergeHalves, [&](int half) {
+    inTwo([&](int half) {
       FlatIndex index(expectedVoxels());
       std::vector<plugin::VoxelAccum>& out = merged[static_cast<std::size_t>(half)];
       out.reserve(expectedVoxels());
@@ -197,7 +198,7 @@ class PclVoxelBackend final : public MapBackend {
 
   std::size_t distinctVoxels() const {
     std::array<std::size_t, kMergeHalves> count{};
-    tbb::parallel_for(0, kMergeHalves, [&](int half) {
+    inTwo([&](int half) {
       FlatIndex index(expectedVoxels());
       forEachPlacedVoxel(
           [&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*, std::uint32_t) {
@@ -210,7 +211,7 @@ class PclVoxelBackend final : public MapBackend {
     return n;
   }
 
-  static constexpr int kMergeHalves = 2;
+  static constexpr int kMergeHalves = 2;  // inTwo()
   static int halfOf(std::uint64_t key) {
     return static_cast<int>((key * 0x9E3779B97F4A7C15ull) >> 63);  // Fibonacci hash, top bit
   }
