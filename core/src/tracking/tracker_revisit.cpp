@@ -68,15 +68,11 @@ std::vector<std::uint64_t> Tracker::Impl::localKeyframes(const Eigen::Isometry3d
   return ids;
 }
 
-// The landmarks of the keyframes near T_W_C that the frame's tracks do not follow, found among
+// The landmarks of `sources` that the frame's tracks do not follow, found among
 // the frame's ORB keypoints (outside track_mask) by projection.
-std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(const RgbdFrame& frame,
-                                                          const cv::Mat& gray,
-                                                          const cv::Mat& track_mask,
-                                                          const Eigen::Isometry3d& T_W_C) {
-  std::vector<std::uint64_t> sources =
-      map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
-  sources.resize(std::min(sources.size(), kReuseSourceKeyframes));
+std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(
+    const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
+    const Eigen::Isometry3d& T_W_C, const std::vector<std::uint64_t>& sources) {
   const LandmarkCandidates candidates =
       withoutLandmarks(map_.landmarksOf(sources), trackedLandmarks());
   OrbFeatures features;
@@ -105,12 +101,17 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(const RgbdFrame& frame
   return found;
 }
 
-// What of the frame's static view no keyframe near it saw outside its movers.
-double Tracker::Impl::uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
-                                    const Eigen::Isometry3d& T_W_C) const {
+std::vector<std::uint64_t> Tracker::Impl::reuseSources(const Eigen::Isometry3d& T_W_C) const {
   std::vector<std::uint64_t> near =
       map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
   near.resize(std::min(near.size(), kReuseSourceKeyframes));
+  return near;
+}
+
+// What of the frame's static view none of `near` saw outside its movers.
+double Tracker::Impl::uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
+                                    const Eigen::Isometry3d& T_W_C,
+                                    const std::vector<std::uint64_t>& near) const {
   CoverageQuery query;
   query.camera = &camera_;
   query.depth_m = &frame.depth_m;
@@ -132,10 +133,13 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                          frame.timestamp_s - config_.kf_reuse_min_age_s);
   if (near.empty()) return false;
   const std::uint64_t kf = near.front();
-  if (uncoveredView(frame, movers, T_W_C) > config_.kf_reuse_max_uncovered_share) return false;
+  const std::vector<std::uint64_t> sources = reuseSources(T_W_C);
+  if (uncoveredView(frame, movers, T_W_C, sources) > config_.kf_reuse_max_uncovered_share) {
+    return false;
+  }
 
   const std::vector<FeatureTrack> saved = tracks_;
-  mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C));
+  mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C, sources));
   // The map covers the view if the frame then tracks kf_min_tracked_ratio of
   // min_tracked_features points, and RANSAC keeps twice min_inliers of them.
   const double needed =

@@ -9,9 +9,10 @@ namespace {
 
 int cellsAcross(int pixels) { return (pixels + kCoverageCellPx - 1) / kCoverageCellPx; }
 
-/// Whether `view` saw p_W inside its image, in one of its static cells.
-bool seesStatic(const PinholeCamera& camera, const CoverageView& view, const Eigen::Vector3d& p_W) {
-  const Eigen::Vector3d p_C = view.T_W_C.inverse() * p_W;
+/// Whether `view` (T_C_W: its pose inverted) saw p_W inside its image, in a static cell.
+bool seesStatic(const PinholeCamera& camera, const CoverageView& view,
+                const Eigen::Isometry3d& T_C_W, const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d p_C = T_C_W * p_W;
   if (p_C.z() <= 0.0) return false;
   const Eigen::Vector2d px = camera.project(p_C);
   if (px.x() < 0.0 || px.y() < 0.0 || px.x() >= camera.width || px.y() >= camera.height) {
@@ -39,6 +40,9 @@ double uncoveredShare(const CoverageQuery& frame, const std::vector<CoverageView
   const PinholeCamera& camera = *frame.camera;
   const cv::Mat& depth = *frame.depth_m;
   const bool any_movers = frame.movers != nullptr && !frame.movers->empty();
+  std::vector<Eigen::Isometry3d> T_C_W;
+  T_C_W.reserve(views.size());
+  for (const CoverageView& view : views) T_C_W.push_back(view.T_W_C.inverse());
   int samples = 0, uncovered = 0;
   for (int v = kCoverageCellPx / 2; v < depth.rows; v += kCoverageCellPx) {
     for (int u = kCoverageCellPx / 2; u < depth.cols; u += kCoverageCellPx) {
@@ -49,8 +53,8 @@ double uncoveredShare(const CoverageQuery& frame, const std::vector<CoverageView
       ++samples;
       const Eigen::Vector3d p_W = frame.T_W_C * camera.backProject(u, v, z);
       bool seen = false;
-      for (const CoverageView& view : views) {
-        if ((seen = seesStatic(camera, view, p_W))) break;
+      for (std::size_t k = 0; k < views.size() && !seen; ++k) {
+        seen = seesStatic(camera, views[k], T_C_W[k], p_W);
       }
       if (!seen) ++uncovered;
     }

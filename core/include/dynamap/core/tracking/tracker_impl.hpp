@@ -121,16 +121,22 @@ class Tracker::Impl {
   /// frame tracks its landmarks (pose refined with them); false (nothing changed) if none does.
   bool reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
                      const cv::Mat& movers, Eigen::Isometry3d& T_W_C, int& inliers);
-  /// Share of the frame's static view that the keyframes near T_W_C did not see outside their
+  /// The keyframes a revisit at T_W_C is judged and tracked against: the nearest 8 within the
+  /// keyframe limits.
+  std::vector<std::uint64_t> reuseSources(const Eigen::Isometry3d& T_W_C) const;
+  /// Share of the frame's static view that the keyframes `near` did not see outside their
   /// movers (view_coverage.hpp).
   double uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
-                       const Eigen::Isometry3d& T_W_C) const;
+                       const Eigen::Isometry3d& T_W_C,
+                       const std::vector<std::uint64_t>& near) const;
   /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
   std::vector<std::uint64_t> localKeyframes(const Eigen::Isometry3d& T_W_C) const;
   std::vector<std::uint64_t> trackedLandmarks() const;
+  /// The landmarks of `sources` the tracks do not follow, found among the frame's keypoints.
   std::vector<FeatureTrack> findMapLandmarks(const RgbdFrame& frame, const cv::Mat& gray,
                                              const cv::Mat& track_mask,
-                                             const Eigen::Isometry3d& T_W_C);
+                                             const Eigen::Isometry3d& T_W_C,
+                                             const std::vector<std::uint64_t>& sources);
   /// Adds the re-found landmarks' tracks; tracks on the same points (newer landmarks) go.
   void mergeTracks(const std::vector<FeatureTrack>& found);
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
