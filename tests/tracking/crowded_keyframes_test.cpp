@@ -1,0 +1,117 @@
+// Keyframes while movers fill the view: none for lack of tracks alone (kf_max_masked_share),
+// unless the tracks left are too few to hold the pose (kf_crowded_min_tracks).
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "dynamap/core/tracker.hpp"
+#include "synthetic_scene.hpp"
+#include "tracking_test_utils.hpp"
+
+namespace dynamap {
+namespace {
+
+constexpr double kFramePeriodS = 1.0 / 30.0;
+constexpr int kFrames = 40;
+constexpr int kSlow = 300;  // ~4 mm a frame: the motion limits make a keyframe every 20 frames
+
+/// Masks the left part of the image (as moving) in frames [first, last] only: `first_share` of
+/// its width at `first`, growing by `growth` a frame up to `last_share`.
+class CrowdedSpanFilter : public MotionFilter {
+ public:
+  struct Span {
+    int first = 10, last = 25;
+    double first_share = 0.6, growth = 0.0, last_share = 0.6;
+  };
+  CrowdedSpanFilter(int width, int height, Span span)
+      : width_(width), height_(height), span_(span) {}
+  void beginFrame(const RgbdFrame&) override {}
+  MotionFilterOutput filter(const MotionFilterInput& input) override {
+    const int frame = frame_++;
+    MotionFilterOutput out;
+    if (frame < span_.first || frame > span_.last) {
+      out.match_is_dynamic.assign(input.matches->cur_px.size(), 0);
+      return out;
+    }
+    const double share = std::min(span_.last_share,
+                                  span_.first_share + span_.growth * (frame - span_.first));
+    const int masked_cols = static_cast<int>(width_ * share);
+    out.dynamic_mask = cv::Mat::zeros(height_, width_, CV_8UC1);
+    out.dynamic_mask.colRange(0, masked_cols).setTo(255);
+    for (const auto& p : input.matches->cur_px) out.match_is_dynamic.push_back(p.x < masked_cols);
+    return out;
+  }
+
+ private:
+  int width_, height_;
+  Span span_;
+  int frame_ = 0;
+};
+
+struct CrowdedRun {
+  int keyframes_in_span = 0, tracked = 0;
+  double worst_m = 0.0;
+};
+
+/// 40 frames of the room on a slow path; in frames 10-25 movers fill the left of the image.
+CrowdedRun trackThroughACrowd(const TrackerConfig& config, CrowdedSpanFilter::Span span) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 23);
+  scene.addDefaultRoom();
+  CrowdedSpanFilter filter(camera.width, camera.height, span);
+  Tracker tracker(camera, config, nullptr);
+  tracker.setMotionFilter(&filter);
+  CrowdedRun run;
+  for (int i = 0; i < kFrames; ++i) {
+    const auto r = scene.render(test::smoothPath(i, kSlow), i * kFramePeriodS);
+    RgbdFrame frame;
+    frame.index = static_cast<std::size_t>(i);
+    frame.timestamp_s = i * kFramePeriodS;
+    frame.bgr = r.bgr;
+    frame.depth_m = r.depth_m;
+    const TrackingResult res = tracker.track(frame);
+    run.tracked += res.status == FrameStatus::kTracked;
+    run.keyframes_in_span += res.is_keyframe && i >= 10 && i <= 25;
+  }
+  tracker.finish();
+  const auto traj = tracker.finalTrajectory();
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const Eigen::Isometry3d truth =
+        test::smoothPath(0, kSlow).inverse() * test::smoothPath(static_cast<int>(i), kSlow);
+    run.worst_m =
+        std::max(run.worst_m, (traj[i].second.translation() - truth.translation()).norm());
+  }
+  return run;
+}
+
+TrackerConfig withMaskedShareLimit(double kf_max_masked_share, int kf_crowded_min_tracks) {
+  TrackerConfig config;
+  config.kf_max_masked_share = kf_max_masked_share;
+  config.kf_crowded_min_tracks = kf_crowded_min_tracks;
+  return config;
+}
+
+TEST(SyntheticTracking, FramesTheMoversFillMakeKeyframesOnlyForMotionNotForLackOfTracks) {
+  const CrowdedRun always = trackThroughACrowd(withMaskedShareLimit(1.0, 0), {});
+  const CrowdedRun crowded = trackThroughACrowd(withMaskedShareLimit(0.35, 0), {});
+  // Masking 60 % of the view drops the tracks below the keyframe limits at once: without the
+  // share limit a keyframe follows; with it, only the motion and time limits make one.
+  EXPECT_GT(always.keyframes_in_span, crowded.keyframes_in_span);
+  EXPECT_EQ(crowded.tracked, kFrames);
+  EXPECT_LT(crowded.worst_m, 0.015);
+}
+
+TEST(SyntheticTracking, AFrameTheMoversFillMakesAKeyframeBeforeItsTracksRunOut) {
+  // Movers spreading from 50 % to 94 % of the view leave too few tracks to hold the pose
+  // through the crowd, unless keyframes seed the rest of the view on the way.
+  const CrowdedSpanFilter::Span spreading{10, 25, 0.5, 0.04, 0.94};
+  const CrowdedRun starved = trackThroughACrowd(withMaskedShareLimit(0.35, 0), spreading);
+  const CrowdedRun fed = trackThroughACrowd(withMaskedShareLimit(0.35, 45), spreading);
+  EXPECT_LT(starved.tracked, kFrames);
+  EXPECT_GT(fed.keyframes_in_span, starved.keyframes_in_span);
+  EXPECT_EQ(fed.tracked, kFrames);
+  EXPECT_LT(fed.worst_m, 0.015);
+}
+
+}  // namespace
+}  // namespace dynamap
