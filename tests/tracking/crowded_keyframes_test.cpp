@@ -33,8 +33,8 @@ class CrowdedSpanFilter : public MotionFilter {
       out.match_is_dynamic.assign(input.matches->cur_px.size(), 0);
       return out;
     }
-    const double share = std::min(span_.last_share,
-                                  span_.first_share + span_.growth * (frame - span_.first));
+    const double share =
+        std::min(span_.last_share, span_.first_share + span_.growth * (frame - span_.first));
     const int masked_cols = static_cast<int>(width_ * share);
     out.dynamic_mask = cv::Mat::zeros(height_, width_, CV_8UC1);
     out.dynamic_mask.colRange(0, masked_cols).setTo(255);
