@@ -70,6 +70,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.reloc_max_hamming", &c.reloc_max_hamming, 1, 256);
   schema.addDouble("tracking.reloc_ratio", &c.reloc_ratio, 0.1, 1.0);
   schema.addInt("tracking.reloc_min_inliers", &c.reloc_min_inliers, 4, 1000);
+  schema.addInt("tracking.reloc_near_last_min_inliers", &c.reloc_near_last_min_inliers, 0, 100000);
   schema.addInt("tracking.restart_after_lost_frames", &c.restart_after_lost_frames, 0, 1000000);
   schema.addBool("tracking.depth_fallback", &c.depth_fallback);
   schema.addBool("tracking.loop_closure", &c.loop_closure);

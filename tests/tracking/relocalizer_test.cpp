@@ -1,7 +1,8 @@
 // Relocalizer (core/src/tracking/relocalizer.cpp) on rendered frames with known poses: a map of
 // two keyframes of a synthetic room; a frame seen from another known pose is relocalized to that
 // pose, from a wrong hint (the global search) and from a near one (the guided search); a frame of
-// a room with other textures is not.
+// a room with other textures is not; fewer inliers than reloc_min_inliers do only near the last
+// tracked pose.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -131,6 +132,28 @@ TEST_F(RelocalizerTest, AFrameOfAnotherSceneIsNotRelocalized) {
     EXPECT_FALSE(r.ok) << "inliers " << r.inliers;
     EXPECT_TRUE(r.landmark_ids.empty());
   }
+}
+
+TEST_F(RelocalizerTest, FewerInliersDoOnlyNearTheLastTrackedPose) {
+  // No number of inliers is enough by itself here: only the near-the-last-pose rule accepts.
+  TrackerConfig near_only = config_;
+  near_only.reloc_min_inliers = 100000;
+  near_only.reloc_near_last_min_inliers = 15;
+  const Relocalizer relocalizer(near_only, optimizer_);
+  const test::RenderedFrame f = scene_.render(kQueryPose, 0.0);
+  const OrbFeatures features = orb_.extractAll(grayOf(f), cv::Mat());
+  // The last tracked pose 2.4 cm and ~1 degree from the frame's: accepted, at the true pose.
+  const Eigen::Isometry3d last_pose = test::cameraPose({0.06, -0.02, 0.05}, 2.0, 1.0);
+  const RelocalizationResult near =
+      relocalizer.relocalize(features, f.depth_m, map_, camera_, last_pose);
+  ASSERT_TRUE(near.ok);
+  EXPECT_LT(poseError(near.T_W_C, kQueryPose).translation_m, 0.01);
+  // The same frame with the last pose 1 m away: the pose is found but not accepted.
+  const Eigen::Isometry3d far_pose = test::cameraPose({-0.9, 0.3, 0.5}, -40.0, 10.0);
+  EXPECT_FALSE(relocalizer.relocalize(features, f.depth_m, map_, camera_, far_pose).ok);
+  near_only.reloc_near_last_min_inliers = 0;  // off
+  const Relocalizer off(near_only, optimizer_);
+  EXPECT_FALSE(off.relocalize(features, f.depth_m, map_, camera_, last_pose).ok);
 }
 
 TEST_F(RelocalizerTest, LandmarksMarkedBadAreNotMatched) {

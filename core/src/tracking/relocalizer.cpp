@@ -1,5 +1,6 @@
 #include "dynamap/core/tracking/relocalizer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -46,11 +47,11 @@ Relocalizer::Relocalizer(const TrackerConfig& config, const PoseOptimizer& optim
 
 RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const cv::Mat& depth_m,
                                              const LocalMap& map, const PinholeCamera& camera,
-                                             const Eigen::Isometry3d& T_W_C_hint) const {
+                                             const Eigen::Isometry3d& T_W_C_last) const {
   if (features.keypoints.size() < 6) return {};
   LandmarkCandidates c;
   map.relocCandidates(config_.reloc_keyframes, c.ids, c.descriptors, c.points);
-  return relocalizeAgainst(features, depth_m, c, camera, T_W_C_hint);
+  return relocalizeNear(features, depth_m, c, camera, T_W_C_last, &T_W_C_last);
 }
 
 RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
@@ -58,6 +59,15 @@ RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
                                                     const LandmarkCandidates& c,
                                                     const PinholeCamera& camera,
                                                     const Eigen::Isometry3d& T_W_C_hint) const {
+  return relocalizeNear(features, depth_m, c, camera, T_W_C_hint, nullptr);
+}
+
+RelocalizationResult Relocalizer::relocalizeNear(const OrbFeatures& features,
+                                                 const cv::Mat& depth_m,
+                                                 const LandmarkCandidates& c,
+                                                 const PinholeCamera& camera,
+                                                 const Eigen::Isometry3d& T_W_C_hint,
+                                                 const Eigen::Isometry3d* T_W_C_last) const {
   if (features.keypoints.size() < 6 || c.ids.size() < 6) return {};
   cv::Mat dist;
   cv::batchDistance(features.descriptors, c.descriptors, dist, CV_32S, cv::noArray(),
@@ -82,7 +92,8 @@ RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
           const cv::Point2f& p = features.keypoints[static_cast<std::size_t>(q)].pt;
           return (proj[ti] - Eigen::Vector2d(p.x, p.y)).squaredNorm() < r2;
         });
-    RelocalizationResult result = solve(features, dist, depth_m, c.ids, c.points, guided);
+    RelocalizationResult result =
+        solve(features, dist, depth_m, c.ids, c.points, guided, T_W_C_last);
     if (result.ok) return result;
   }
   // 2) Global: any landmark of the recent keyframes, ratio test and mutual nearest neighbours.
@@ -95,14 +106,15 @@ RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
     cv::minMaxLoc(dist.col(global[q]), &min_val, nullptr, &min_loc);
     if (min_loc.y != static_cast<int>(q)) global[q] = -1;
   }
-  return solve(features, dist, depth_m, c.ids, c.points, global);
+  return solve(features, dist, depth_m, c.ids, c.points, global, T_W_C_last);
 }
 
 RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::Mat& dist,
                                         const cv::Mat& depth_m,
                                         const std::vector<std::uint64_t>& ids,
                                         const std::vector<Eigen::Vector3d>& points,
-                                        const std::vector<int>& match) const {
+                                        const std::vector<int>& match,
+                                        const Eigen::Isometry3d* T_W_C_last) const {
   RelocalizationResult result;
   std::vector<PoseCorrespondence> corr;
   std::vector<int> query_index;
@@ -127,12 +139,15 @@ RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::M
     corr.push_back(pc);
     query_index.push_back(static_cast<int>(q));
   }
-  if (static_cast<int>(corr.size()) < config_.reloc_min_inliers) return result;
+  const int fewest = T_W_C_last != nullptr && config_.reloc_near_last_min_inliers > 0
+                         ? std::min(config_.reloc_min_inliers, config_.reloc_near_last_min_inliers)
+                         : config_.reloc_min_inliers;
+  if (static_cast<int>(corr.size()) < fewest) return result;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::vector<std::uint8_t> inlier;
   if (!optimizer_.ransac(corr, T_W_C, inlier, false, kRelocRansacIterations)) return result;
   const int count = optimizer_.refine(corr, T_W_C, inlier);
-  if (count < config_.reloc_min_inliers) return result;
+  if (!enoughInliers(count, T_W_C, T_W_C_last)) return result;
   result.ok = true;
   result.T_W_C = T_W_C;
   result.inliers = count;
@@ -143,6 +158,19 @@ RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::M
     result.px.push_back(features.keypoints[q].pt);
   }
   return result;
+}
+
+bool Relocalizer::enoughInliers(int inliers, const Eigen::Isometry3d& T_W_C,
+                                const Eigen::Isometry3d* T_W_C_last) const {
+  if (inliers >= config_.reloc_min_inliers) return true;
+  if (T_W_C_last == nullptr || config_.reloc_near_last_min_inliers <= 0 ||
+      inliers < config_.reloc_near_last_min_inliers) {
+    return false;
+  }
+  constexpr double kNearM = 0.10, kNearRad = 10.0 * M_PI / 180.0;
+  const Eigen::Isometry3d step = T_W_C_last->inverse() * T_W_C;
+  return step.translation().norm() <= kNearM &&
+         Eigen::AngleAxisd(step.linear()).angle() <= kNearRad;
 }
 
 }  // namespace dynamap

@@ -139,6 +139,9 @@ struct TrackerConfig {
   int reloc_max_hamming = 64;  ///< ORB descriptor distance gate
   double reloc_ratio = 0.8;    ///< Lowe ratio test
   int reloc_min_inliers = 20;  ///< inliers needed to accept a relocalization
+  /// ... or this many, when the pose lies within 10 cm and 10 deg of the last tracked one (a
+  /// view the movers fill for a moment: the Bonn slice's relocalizations found 16-19); 0 = off.
+  int reloc_near_last_min_inliers = 15;
   /// After this many frames lost in a row the map restarts where the camera was last seen
   /// (0 = never: stay lost until relocalization succeeds).
   int restart_after_lost_frames = 5;

@@ -28,9 +28,11 @@ struct RelocalizationResult {
 class Relocalizer {
  public:
   Relocalizer(const TrackerConfig& config, const PoseOptimizer& optimizer);
+  /// `T_W_C_last`: the last tracked pose; near it, fewer inliers do
+  /// (TrackerConfig::reloc_near_last_min_inliers).
   RelocalizationResult relocalize(const OrbFeatures& features, const cv::Mat& depth_m,
                                   const LocalMap& map, const PinholeCamera& camera,
-                                  const Eigen::Isometry3d& T_W_C_hint) const;
+                                  const Eigen::Isometry3d& T_W_C_last) const;
   /// The same against given candidates (e.g. the landmarks around the keyframes that place
   /// recognition found), `T_W_C_hint` guiding the first search.
   RelocalizationResult relocalizeAgainst(const OrbFeatures& features, const cv::Mat& depth_m,
@@ -38,11 +40,19 @@ class Relocalizer {
                                          const Eigen::Isometry3d& T_W_C_hint) const;
 
  private:
+  RelocalizationResult relocalizeNear(const OrbFeatures& features, const cv::Mat& depth_m,
+                                      const LandmarkCandidates& c, const PinholeCamera& camera,
+                                      const Eigen::Isometry3d& T_W_C_hint,
+                                      const Eigen::Isometry3d* T_W_C_last) const;
   /// match[q] = candidate index of query q or -1.
   RelocalizationResult solve(const OrbFeatures& features, const cv::Mat& dist,
                              const cv::Mat& depth_m, const std::vector<std::uint64_t>& ids,
                              const std::vector<Eigen::Vector3d>& points,
-                             const std::vector<int>& match) const;
+                             const std::vector<int>& match,
+                             const Eigen::Isometry3d* T_W_C_last) const;
+  /// Enough inliers for `T_W_C`: reloc_min_inliers, or fewer near `T_W_C_last`.
+  bool enoughInliers(int inliers, const Eigen::Isometry3d& T_W_C,
+                     const Eigen::Isometry3d* T_W_C_last) const;
 
   TrackerConfig config_;
   const PoseOptimizer& optimizer_;
