@@ -5,6 +5,10 @@
                                                       run one case, compare with bands.json
   bands.py measure --dynamap BIN [BIN ...] [--cases A,B] [--work DIR]
                                                       run every case's variants, write bands.json
+  bands.py sweep --dynamap BIN [--cases A,B] [--set KEY=VALUE ...]
+                                                      run each case from every start frame of
+                                                      `measure`, print each run and the means
+                                                      (judge a change on more than one run)
   bands.py limits                                     recompute every limit from the samples
                                                       in bands.json (after a change of the rule)
   bands.py table                                      bands.json as a Markdown table
@@ -232,6 +236,23 @@ def measure(args):
     return 0
 
 
+def sweep(args):
+    """Each case from every start frame, one build, overrides: each run and the means."""
+    cases = args.cases.split(",") if args.cases else list(CASES)
+    for case in cases:
+        runs = []
+        for start in STARTS:
+            seq = prepare(case, start, args.work)
+            values = run(args.dynamap[0], case, seq, os.path.join(args.work, case + "_sweep"),
+                         args.set)
+            runs.append(values)
+            print("%s start %d: %s" % (case, start, json.dumps(values)), flush=True)
+        means = {m: statistics.fmean(r[m] for r in runs) for m in runs[0]}
+        print("%s mean of %d: %s" % (case, len(runs), " ".join(
+            "%s %.4g" % (m, v) for m, v in means.items())), flush=True)
+    return 0
+
+
 def recompute_limits():
     result = load_bands()
     for case, metrics in result["cases"].items():
@@ -282,13 +303,13 @@ def cpu_model():
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("command", choices=["check", "measure", "limits", "table", "list"])
+    parser.add_argument("command", choices=["check", "measure", "sweep", "limits", "table", "list"])
     parser.add_argument("case", nargs="?")
     parser.add_argument("--dynamap", nargs="+", default=[os.path.join(SOURCE, "build/bin/dynamap")])
     parser.add_argument("--builds", nargs="*", help="names of the --dynamap builds (measure)")
-    parser.add_argument("--cases", help="comma list (measure; default all)")
+    parser.add_argument("--cases", help="comma list (measure, sweep; default all)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a configuration override for the run (check)")
+                        help="a configuration override for the runs (check, sweep)")
     parser.add_argument("--work", default="/tmp/dynamap_real_data")
     args = parser.parse_args()
     try:
@@ -304,6 +325,8 @@ def main():
                 raise SystemExit("real_data: unknown case '%s' (known: %s)" % (args.case,
                                                                               ", ".join(CASES)))
             return check(args)
+        if args.command == "sweep":
+            return sweep(args)
         return measure(args)
     except DataMissing as e:
         print(e, file=sys.stderr)
