@@ -232,6 +232,9 @@ def measure(args):
         "date": datetime.datetime.now(datetime.timezone.utc).date().isoformat(),
         "machine": "%s, %d cores" % (cpu_model(), os.cpu_count()),
     }
+    for case in cases:  # the cases not measured now keep theirs
+        result.setdefault("measured_at", {})[case] = {
+            k: result["how_measured"][k] for k in ("commit", "date", "machine", "builds")}
     write_bands(result)
     return 0
 
@@ -266,8 +269,9 @@ def print_table():
     """One row a case, one column a metric: the samples' mean and the band's limit."""
     result = load_bands()
     how = result["how_measured"]
-    print("Measured %s at %s on %s: `%s`. A cell: the mean of the samples, then the limit "
-          "(≤ at most, ≥ at least).\n" % (how["date"], how["commit"], how["machine"], how["command"]))
+    print("Last measured %s at %s on %s: `%s` (each case's commit and date: `measured_at` in "
+          "bands.json). A cell: the mean of the samples, then the limit (≤ at most, ≥ at least)."
+          "\n" % (how["date"], how["commit"], how["machine"], how["command"]))
     print("| case | " + " | ".join(METRICS) + " |")
     print("|---" * (len(METRICS) + 1) + "|")
     for case, metrics in sorted(result["cases"].items()):
