@@ -12,7 +12,8 @@ cd "$(dirname "$0")/.."
 START=$SECONDS
 stage() { echo "test.sh: $1 done at $((SECONDS - START)) s"; }
 bash scripts/install_deps.sh
-bash scripts/build.sh
+# The test suites as unity builds (cmake/DynamapUnity.cmake); the libraries one file at a time.
+bash scripts/build.sh -DDYNAMAP_UNITY_TESTS=ON
 stage "install + build"
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"${JOBS:-2}" --timeout 900)
 stage "tests"
