@@ -25,7 +25,7 @@ function(dynamap_target_defaults target)
     target_compile_options(${target} PRIVATE -fsanitize=thread -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=thread)
   endif()
-  if(DYNAMAP_FUZZ)
+  if(DYNAMAP_FUZZ AND DYNAMAP_FUZZ_COVERAGE)
     # Coverage feedback for libFuzzer from our libraries; the fuzzers themselves link
     # -fsanitize=fuzzer (fuzz/CMakeLists.txt).
     target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan, libraries with coverage instrumentation)
-# into build-fuzz (FUZZ_BUILD_DIR) and runs each one for
-# N seconds (default 10: the CI smoke run; e.g. 600 for a long run), TEST_JOBS (default 2) at
-# a time, niced (each target keeps a core for its N seconds).
+# into build-fuzz (FUZZ_BUILD_DIR) and runs each one for N seconds (default 10; e.g. 600 for a
+# long run; CI smoke-runs them in build-asan instead, scripts/sanitize.sh), TEST_JOBS (default 2)
+# at a time, niced (each target keeps a core for its N seconds).
 #   scripts/fuzz.sh [seconds-per-target]
 # Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-fuzz/fuzz/corpus/<target>/.
 # A crash leaves build-fuzz/fuzz/<target>-crash-* and makes the script fail; turn it into a

@@ -17,19 +17,31 @@ cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 WHAT=${1:-all}
 source scripts/clang_setup.sh  # clang, GENERATOR, LINES_ONLY
+# Unity builds (cmake/DynamapUnity.cmake): a target's files compile in batches of 8 (the heavy
+# headers parsed once a batch); the Release build keeps one file at a time, so every file is
+# still checked to compile on its own.
 CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
-  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY")
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY"
+  -DCMAKE_UNITY_BUILD=ON)
 
 run_asan() {
   local dir=${ASAN_BUILD_DIR:-build-asan}
-  # DYNAMAP_FUZZ=OFF: no libFuzzer coverage instrumentation (scripts/fuzz.sh builds the fuzzers
-  # in build-fuzz). It made this suite 3x slower (two tracking tests 65.7 s -> 20.9 s), more than
-  # building the libraries a second time costs.
-  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=OFF \
+  # The fuzzers are built here too (DYNAMAP_FUZZ=ON) for the smoke run, FUZZ_SECONDS (default 10)
+  # each, 0 for none; DYNAMAP_FUZZ_COVERAGE=OFF: only the harnesses carry libFuzzer's coverage
+  # instrumentation. On the libraries it made this suite 3x slower (two tracking tests 65.7 s ->
+  # 20.9 s without); scripts/fuzz.sh keeps a coverage-guided build (build-fuzz) for long runs.
+  local fuzz_seconds=${FUZZ_SECONDS:-10} fuzzers=()
+  if [ "$fuzz_seconds" != 0 ]; then fuzzers=(dynamap_fuzzers); fi
+  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_SANITIZE=ON -DDYNAMAP_FUZZ=ON \
+    -DDYNAMAP_FUZZ_COVERAGE=OFF -DDYNAMAP_FUZZ_SECONDS="$fuzz_seconds" \
     -DDYNAMAP_FAST_PATHS=OFF >/dev/null
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_io_tests dynamap_eval_tests dynamap_tracking_tests dynamap_dynamic_tests \
-    dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests dynamap_loop_tests
+    dynamap_mapping_tests dynamap_cli_tests dynamap_system_tests dynamap_loop_tests "${fuzzers[@]}"
+  if [ "$fuzz_seconds" != 0 ]; then
+    # Each fuzzer from the seeds in fuzz/corpus for fuzz_seconds, as scripts/fuzz.sh runs them.
+    nice -n 19 ctest --test-dir "$dir" -L fuzz --output-on-failure -j"${TEST_JOBS:-2}"
+  fi
   # detect_leaks: OpenCV/TBB/OpenVDB keep process-lifetime caches; leaks are checked too, with
   # the third-party ones listed in scripts/lsan.supp.
   # alloc_dealloc_mismatch=0: Debian's PCL is built as C++14, where Eigen gives PointCloud a
