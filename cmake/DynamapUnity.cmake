@@ -14,6 +14,7 @@ function(dynamap_unity_alone dir)
 endfunction()
 dynamap_unity_alone(mapping src/mapping_worker.cpp)
 dynamap_unity_alone(tests io/tum_dataset_test.cpp tracking/local_ba_thread_test.cpp
+                    tracking/crowded_keyframes_test.cpp
                     loop/tracker_loop_test.cpp system/system_test.cpp system/saved_map_test.cpp
                     mapping/visibility_brief_test.cpp mapping/visibility_test.cpp
                     mapping/mask_lookahead_test.cpp dynamic/fusion_identity_test.cpp
