@@ -1,10 +1,10 @@
-# Unity builds (cmake -DCMAKE_UNITY_BUILD=ON; the sanitizer builds of scripts/sanitize.sh): each
-# target's .cpp files compile in batches of 8, so OpenCV, Eigen, Ceres, OpenVDB and GoogleTest
-# headers are parsed once a batch, not once a file (the 8 files of core's 4th batch: 76.9 s
+# Unity builds (CMAKE_UNITY_BUILD, ON by default: CMakeLists.txt): each target's .cpp files
+# compile in batches of 8, so OpenCV, Eigen, Ceres, OpenVDB and GoogleTest headers are parsed
+# once a batch, not once a file (the 8 files of core's 4th batch: 76.9 s
 # of CPU one by one, 36.3 s as one, clang ASan). A file whose file-local names (anonymous
 # namespace) clash with, or would overload, those of another file of its target compiles
 # alone, listed here (found by building all of them; a clash is a compile error).
-if(NOT (CMAKE_UNITY_BUILD OR DYNAMAP_UNITY_TESTS))
+if(NOT CMAKE_UNITY_BUILD)
   return()
 endif()
 function(dynamap_unity_alone dir)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan, libraries with coverage instrumentation)
 # into build-fuzz (FUZZ_BUILD_DIR) and runs each one for N seconds (default 10; e.g. 600 for a
-# long run; CI smoke-runs them in build-asan instead, scripts/sanitize.sh), TEST_JOBS (default 2)
+# long run; scripts/sanitize.sh asan smoke-runs them in build-asan instead), TEST_JOBS (default 2)
 # at a time, niced (each target keeps a core for its N seconds).
 #   scripts/fuzz.sh [seconds-per-target]
 # Seeds: fuzz/corpus/<target>/ (read only); new inputs: build-fuzz/fuzz/corpus/<target>/.

@@ -1,25 +1,26 @@
 #!/usr/bin/env bash
 # Runs the test suite under sanitizers (clang):
 #   asan: everything under AddressSanitizer + UndefinedBehaviorSanitizer, in build-asan
-#   tsan: the threaded tests (tracking BA thread, mapping worker, visibility pass, CLI runs) under
-#         ThreadSanitizer, in build-tsan, with scripts/tsan.supp
+#   tsan: the threaded tests (tracking BA and loop threads, mapping worker, visibility pass,
+#         detector worker, CLI runs) under ThreadSanitizer + UBSan, in build-tsan, with
+#         scripts/tsan.supp
 #   scripts/sanitize.sh [asan|tsan|all]   (default all)
-# Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, JOBS (compile jobs, default 2), TEST_JOBS (tests run at
-# once, default 2: half the wall time of one at a time on 2 cores; it also lets a signal land on
-# another thread, which is how TSan found the interrupt flag's race), CTEST_ARGS (extra).
+# Env: ASAN_BUILD_DIR, TSAN_BUILD_DIR, TSAN_TESTS (all, the default, or short), JOBS (compile
+# jobs, default 2), TEST_JOBS (tests run at once, default 2: half the wall time of one at a
+# time on 2 cores; it also lets a signal land on another thread, which is how TSan found the
+# interrupt flag's race), CTEST_ARGS (extra).
 # By ctest label (tests/CMakeLists.txt): ASan runs every test but the fuzz, timing (wall-clock
 # bounds a 2-10x sanitizer slowdown breaks) and real_data ones (whole runs, measured in the
-# Release build); its build leaves the fast paths out (-DDYNAMAP_FAST_PATHS=OFF), so the portable
-# code is built and tested once in every CI run. TSan runs the "threaded" tests (every suite
-# with threads is built) but the timing ones. CTEST_ARGS adds ctest arguments.
+# Release build). TSan runs the threaded tests but the timing ones; TSAN_TESTS=short (CI's,
+# scripts/test.sh) leaves out the threaded_long ones too. Both builds leave the fast paths out
+# (-DDYNAMAP_FAST_PATHS=OFF): the portable code is built and tested in every CI run; both add
+# UndefinedBehaviorSanitizer. CTEST_ARGS adds ctest arguments.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 WHAT=${1:-all}
 source scripts/clang_setup.sh  # clang, GENERATOR, LINES_ONLY
-# Unity builds (cmake/DynamapUnity.cmake): a target's files compile in batches of 8 (the heavy
-# headers parsed once a batch); the Release build keeps one file at a time, so every file is
-# still checked to compile on its own.
+# Unity builds, as the Release build (cmake/DynamapUnity.cmake).
 CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
   "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY"
   -DCMAKE_UNITY_BUILD=ON)
@@ -61,17 +62,21 @@ run_asan() {
 
 run_tsan() {
   local dir=${TSAN_BUILD_DIR:-build-tsan}
-  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_TSAN=ON >/dev/null
+  cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_TSAN=ON \
+    -DDYNAMAP_FAST_PATHS=OFF >/dev/null
   # Also for the build: gtest_discover_tests runs the test programs.
   export TSAN_OPTIONS="suppressions=$ROOT/scripts/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export OMP_NUM_THREADS=1 OPENCV_FOR_THREADS_NUM=1
   nice -n 19 cmake --build "$dir" -j"${JOBS:-2}" --target dynamap dynamap_backends \
     dynamap_tracking_tests dynamap_mapping_tests dynamap_cli_tests dynamap_dynamic_tests \
     dynamap_system_tests dynamap_loop_tests
   # OMP_NUM_THREADS=1 / OPENCV_FOR_THREADS_NUM=1: Ceres (OpenMP) and OpenCV (TBB) run their
   # loops on the calling thread, so TSan sees no uninstrumented pool; see scripts/tsan.supp.
-  nice -n 19 ctest --test-dir "$dir" -L threaded -LE timing --output-on-failure -j"${TEST_JOBS:-2}" \
-      ${CTEST_ARGS:-}
+  local label=threaded  # a regular expression: threaded and threaded_long
+  if [ "${TSAN_TESTS:-all}" = short ]; then label='^threaded$'; fi
+  nice -n 19 ctest --test-dir "$dir" -L "$label" -LE timing --output-on-failure \
+      -j"${TEST_JOBS:-2}" ${CTEST_ARGS:-}
 }
 
 case "$WHAT" in

@@ -12,6 +12,7 @@
 //   auto f = scene.render(T_W_C, t_s);                  // f.bgr, f.depth_m, f.mask
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -91,6 +92,8 @@ class SyntheticScene {
   const PinholeCamera& camera() const { return camera_; }
 
  private:
+  static constexpr double kNearM = 0.05;  ///< nearer surfaces are not drawn
+
   struct Rect {
     Eigen::Vector3d origin, edge_u, edge_v;
     cv::Mat texture;  // CV_8UC3
@@ -148,26 +151,8 @@ class SyntheticScene {
     const Eigen::Vector3d ev = T_C_W.linear() * r.edge_v;
     const Eigen::Vector3d n = eu.cross(ev);
     const double inv_uu = 1.0 / eu.squaredNorm(), inv_vv = 1.0 / ev.squaredNorm();
-    // Pixel bounding box of the projected corners (whole image if a corner is behind).
-    int x0 = 0, y0 = 0, x1 = camera_.width - 1, y1 = camera_.height - 1;
-    const Eigen::Vector3d corners[4] = {o, o + eu, o + ev, o + eu + ev};
-    bool all_front = true;
-    double minx = 1e9, miny = 1e9, maxx = -1e9, maxy = -1e9;
-    for (const auto& c : corners) {
-      if (c.z() < 0.05) {
-        all_front = false;
-        break;
-      }
-      const Eigen::Vector2d uv = camera_.project(c);
-      minx = std::min(minx, uv.x()), maxx = std::max(maxx, uv.x());
-      miny = std::min(miny, uv.y()), maxy = std::max(maxy, uv.y());
-    }
-    if (all_front) {
-      x0 = std::max(x0, static_cast<int>(std::floor(minx)));
-      y0 = std::max(y0, static_cast<int>(std::floor(miny)));
-      x1 = std::min(x1, static_cast<int>(std::ceil(maxx)));
-      y1 = std::min(y1, static_cast<int>(std::ceil(maxy)));
-    }
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    if (!pixelBounds({o, o + eu, o + eu + ev, o + ev}, x0, y0, x1, y1)) return;
     const double n_dot_o = n.dot(o);
     const int tw = r.texture.cols, th = r.texture.rows;
     // Rows are independent: render them in parallel.
@@ -182,7 +167,7 @@ class SyntheticScene {
           const double denom = n.dot(d);
           if (std::abs(denom) < 1e-12) continue;
           const double z = n_dot_o / denom;
-          if (z < 0.05 || (depth[x] > 0.f && z >= depth[x])) continue;
+          if (z < kNearM || (depth[x] > 0.f && z >= depth[x])) continue;
           const Eigen::Vector3d p = z * d - o;
           const double a = p.dot(eu) * inv_uu, b = p.dot(ev) * inv_vv;
           if (a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0) continue;
@@ -192,6 +177,38 @@ class SyntheticScene {
         }
       }
     });
+  }
+
+  /// Pixel bounding box (x0..x1, y0..y1, inside the image, one pixel of margin) of the convex
+  /// polygon `corners` (camera frame) clipped to z >= kNearM; false when none of it is in front.
+  /// A rectangle reaching behind the camera is bounded by its visible part, not by the whole
+  /// image (a room around the camera: most of its walls reach behind it).
+  bool pixelBounds(const std::array<Eigen::Vector3d, 4>& corners, int& x0, int& y0, int& x1,
+                   int& y1) const {
+    std::vector<Eigen::Vector3d> front;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      const Eigen::Vector3d& a = corners[i];
+      const Eigen::Vector3d& b = corners[(i + 1) % corners.size()];
+      if (a.z() >= kNearM) front.push_back(a);
+      if ((a.z() >= kNearM) != (b.z() >= kNearM)) {
+        front.push_back(a + (b - a) * ((kNearM - a.z()) / (b.z() - a.z())));
+      }
+    }
+    if (front.empty()) return false;
+    double minx = 1e9, miny = 1e9, maxx = -1e9, maxy = -1e9;
+    for (const auto& c : front) {
+      const Eigen::Vector2d uv = camera_.project(c);
+      minx = std::min(minx, uv.x()), maxx = std::max(maxx, uv.x());
+      miny = std::min(miny, uv.y()), maxy = std::max(maxy, uv.y());
+    }
+    const auto clampTo = [](double v, int hi) {
+      return static_cast<int>(std::clamp(v, -1.0, static_cast<double>(hi) + 1.0));
+    };
+    x0 = std::max(0, clampTo(std::floor(minx), camera_.width) - 1);
+    y0 = std::max(0, clampTo(std::floor(miny), camera_.height) - 1);
+    x1 = std::min(camera_.width - 1, clampTo(std::ceil(maxx), camera_.width) + 1);
+    y1 = std::min(camera_.height - 1, clampTo(std::ceil(maxy), camera_.height) + 1);
+    return x0 <= x1 && y0 <= y1;
   }
 
   static cv::Vec3b sample(const cv::Mat& tex, double u, double v) {

@@ -31,7 +31,6 @@ TEST(LoopClosure, RevisitRemovesInjectedDrift) {
   TimingRecorder timings;
   LoopCloser closer(camera, config, LoopCloserConfig{}, &timings);
   std::mt19937 rng(3);
-  std::normal_distribution<double> n(0.0, 1.0);
 
   // As the tracker would: each keyframe added with the generation of the corrections it has
   // applied; a detected loop is closed at once and the correction applied to the estimate.
@@ -39,16 +38,12 @@ TEST(LoopClosure, RevisitRemovesInjectedDrift) {
   std::vector<Eigen::Isometry3d> truth, estimate, odometry_only;
   int generation = 0, closes = 0;
   for (int k = 0; k < kKeyframes; ++k) {
-    const double a = 7.5 * k;
-    truth.push_back(test::cameraPose({std::sin(a * kDeg), 0.0, std::cos(a * kDeg)}, a, 0.0));
+    truth.push_back(test::circleKeyframePose(k));
     if (k == 0) {
       estimate.push_back(truth[0]);
       odometry_only.push_back(truth[0]);
     } else {
-      const Eigen::Vector3d rot(0.1 * kDeg + 0.05 * kDeg * n(rng), 0.3 * kDeg, 0.05 * kDeg * n(rng));
-      const Eigen::Vector3d t(0.005 * n(rng), 0.005 * n(rng), 0.005 * n(rng));
-      const Eigen::Isometry3d step =
-          truth[k - 1].inverse() * truth[k] * test::smallMotion(rot, t);
+      const Eigen::Isometry3d step = test::driftingStep(truth[k - 1], truth[k], rng);
       estimate.push_back(estimate.back() * step);
       odometry_only.push_back(odometry_only.back() * step);
     }

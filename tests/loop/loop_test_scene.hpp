@@ -91,6 +91,24 @@ inline Eigen::Isometry3d smallMotion(const Eigen::Vector3d& rot_rad, const Eigen
   return T;
 }
 
+/// The camera of the loop room's circle: keyframe k at 7.5 k deg of yaw, 1 m from the centre
+/// (48 keyframes a round).
+inline Eigen::Isometry3d circleKeyframePose(int k) {
+  const double a = 7.5 * k, rad = a * M_PI / 180.0;
+  return cameraPose({std::sin(rad), 0.0, std::cos(rad)}, a, 0.0);
+}
+
+/// Odometry from `from` to `to` as a drifting tracker measures it: 0.3 deg of yaw and 0.1 deg of
+/// pitch too much per step, plus noise (0.05 deg, 5 mm; seeded by `rng`).
+inline Eigen::Isometry3d driftingStep(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to,
+                                      std::mt19937& rng) {
+  constexpr double kDeg = M_PI / 180.0;
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Eigen::Vector3d rot(0.1 * kDeg + 0.05 * kDeg * n(rng), 0.3 * kDeg, 0.05 * kDeg * n(rng));
+  const Eigen::Vector3d t(0.005 * n(rng), 0.005 * n(rng), 0.005 * n(rng));
+  return from.inverse() * to * smallMotion(rot, t);
+}
+
 inline double rotationDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
 }
