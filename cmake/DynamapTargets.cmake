@@ -10,16 +10,20 @@ endif()
 function(dynamap_target_defaults target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror
                                            -Wno-error=deprecated-declarations)
-  if(DYNAMAP_SANITIZE OR DYNAMAP_TSAN)
-    target_compile_options(${target} PRIVATE -fsanitize=${DYNAMAP_SANITIZERS}
+  if(DYNAMAP_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined
                                              -fno-sanitize-recover=undefined
                                              -fno-omit-frame-pointer)
-    target_link_options(${target} PRIVATE -fsanitize=${DYNAMAP_SANITIZERS})
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
     if(CMAKE_CXX_COMPILER_ID MATCHES "Clang" AND target STREQUAL "dynamap_backend_vdb_tsdf")
       # TBB headers (OpenVDB's accessor registry): see scripts/ubsan_ignore.txt.
       target_compile_options(${target} PRIVATE
         -fsanitize-ignorelist=${PROJECT_SOURCE_DIR}/scripts/ubsan_ignore.txt)
     endif()
+  endif()
+  if(DYNAMAP_TSAN)
+    target_compile_options(${target} PRIVATE -fsanitize=thread -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=thread)
   endif()
   if(DYNAMAP_FUZZ AND DYNAMAP_FUZZ_COVERAGE)
     # Coverage feedback for libFuzzer from our libraries; the fuzzers themselves link
@@ -29,12 +33,9 @@ function(dynamap_target_defaults target)
 endfunction()
 
 # Sanitizer flags must reach every object that links the runtime (executables, plugins).
-# UndefinedBehaviorSanitizer rides along with either (ASan's build or TSan's).
 if(DYNAMAP_SANITIZE)
-  set(DYNAMAP_SANITIZERS address,undefined)
-elseif(DYNAMAP_TSAN)
-  set(DYNAMAP_SANITIZERS thread,undefined)
+  add_link_options(-fsanitize=address,undefined)
 endif()
-if(DYNAMAP_SANITIZERS)
-  add_link_options(-fsanitize=${DYNAMAP_SANITIZERS})
+if(DYNAMAP_TSAN)
+  add_link_options(-fsanitize=thread)
 endif()

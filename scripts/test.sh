@@ -2,7 +2,7 @@
 # README command 2: install what is missing, build, run the test suite:
 #   1. every ctest test of the Release build (unit, threaded, timing, simd, real_data);
 #   2. the sanitizer runs (scripts/sanitize.sh), SANITIZERS="tsan" by default: the threaded
-#      tests under ThreadSanitizer + UBSan, built without the fast paths (the portable code);
+#      tests under ThreadSanitizer, built without the fast paths (the portable code);
 #      TSAN_TESTS=short (default here) leaves out the threaded_long ones (whole runs whose
 #      threads the shorter tests run too; scripts/sanitize.sh tsan alone runs every one).
 #      SANITIZERS="asan tsan" adds the whole suite under ASan + UBSan with the fuzzers' smoke
