@@ -16,8 +16,6 @@
 namespace dynamap {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 TrackerConfig testConfig() { return TrackerConfig{}; }
 
 // Tolerances: end-point error after <= 20 % of before (the issue's >= 80 % reduction); every

@@ -91,12 +91,14 @@ inline Eigen::Isometry3d smallMotion(const Eigen::Vector3d& rot_rad, const Eigen
   return T;
 }
 
-/// The camera of the loop room's circle: keyframe k at 7.5 k deg of yaw, 1 m from the centre
-/// (48 keyframes a round).
-inline Eigen::Isometry3d circleKeyframePose(int k) {
-  const double a = 7.5 * k, rad = a * M_PI / 180.0;
-  return cameraPose({std::sin(rad), 0.0, std::cos(rad)}, a, 0.0);
+/// The camera on the loop room's circle (1 m from the centre) at `yaw_deg`, looking outward.
+inline Eigen::Isometry3d circlePose(double yaw_deg) {
+  const double rad = yaw_deg * M_PI / 180.0;
+  return cameraPose({std::sin(rad), 0.0, std::cos(rad)}, yaw_deg, 0.0);
 }
+
+/// Keyframe k of the loop room's circle: 7.5 k deg of yaw (48 keyframes a round).
+inline Eigen::Isometry3d circleKeyframePose(int k) { return circlePose(7.5 * k); }
 
 /// Odometry from `from` to `to` as a drifting tracker measures it: 0.3 deg of yaw and 0.1 deg of
 /// pitch too much per step, plus noise (0.05 deg, 5 mm; seeded by `rng`).

@@ -18,7 +18,6 @@
 namespace dynamap {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kStepDeg = 2.0;  ///< camera yaw per frame
 constexpr int kFrames = 201;      ///< 400 deg: round once, then 40 deg of the start again
 constexpr double kFramePeriodS = 1.0 / 30.0;
@@ -42,10 +41,7 @@ cv::Mat tiltDepth(const cv::Mat& depth_m, double cx) {
   return out;
 }
 
-Eigen::Isometry3d truePose(int i) {
-  const double a = kStepDeg * i;
-  return test::cameraPose({std::sin(a * kDeg), 0.0, std::cos(a * kDeg)}, a, 0.0);
-}
+Eigen::Isometry3d truePose(int i) { return test::circlePose(kStepDeg * i); }
 
 struct LoopRun {
   std::vector<std::pair<double, Eigen::Isometry3d>> trajectory;
