@@ -21,7 +21,7 @@ cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 WHAT=${1:-all}
 source scripts/clang_setup.sh  # clang, GENERATOR, LINES_ONLY
-# Unity builds, as the Release build (cmake/DynamapUnity.cmake).
+# Unity builds, as the Release build (CMakeLists.txt).
 CLANG=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
   "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$LINES_ONLY" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$LINES_ONLY"
   -DCMAKE_UNITY_BUILD=ON)
@@ -63,7 +63,11 @@ run_asan() {
 
 run_tsan() {
   local dir=${TSAN_BUILD_DIR:-build-tsan}
+  # -O1 (TSan's documented minimum): compiles in 270 s instead of 287 s on 2 cores, and the 93
+  # short threaded tests ran in 208 s, as fast as at -O2 (220 s), 2026-12-02.
+  local o1="${LINES_ONLY/-O2/-O1}"
   cmake -S . -B "$dir" "${GENERATOR[@]}" "${CLANG[@]}" -DDYNAMAP_TSAN=ON \
+    "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$o1" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$o1" \
     -DDYNAMAP_FAST_PATHS=OFF >/dev/null
   # Also for the build: gtest_discover_tests runs the test programs.
   export TSAN_OPTIONS="suppressions=$ROOT/scripts/tsan.supp:halt_on_error=1:second_deadlock_stack=1"

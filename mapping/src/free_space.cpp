@@ -9,7 +9,7 @@ namespace dynamap {
 
 namespace {
 
-constexpr float kNoReading = 1e3f;
+constexpr float kFreeSpaceNoReading = 1e3f;
 
 cv::Mat halfResolution(const cv::Mat& depth_m) {
   cv::Mat half;
@@ -83,9 +83,9 @@ FreeSpaceView makeFreeSpaceView(const cv::Mat& depth_m, const Eigen::Isometry3d&
   if (depth_m.empty()) return view;
   cv::Mat d = halfResolution(depth_m);
   cv::Mat invalid = d <= 0.f;
-  d.setTo(kNoReading, invalid);
+  d.setTo(kFreeSpaceNoReading, invalid);
   cv::erode(d, d, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));  // nearest in the window
-  d.setTo(0.f, d >= kNoReading);
+  d.setTo(0.f, d >= kFreeSpaceNoReading);
   view.near_half_m = d;
   return view;
 }

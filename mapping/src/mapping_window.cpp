@@ -8,7 +8,6 @@
 namespace dynamap {
 namespace {
 
-constexpr double kDepthUnitsPerM = 5000.0;  // as mapping_worker.cpp's records
 constexpr double kRevisitReachM = 0.5;      // a kept view judges keyframes this near...
 constexpr double kRevisitReachRad = 30.0 * 3.14159265358979 / 180.0;  // ... and turned
 constexpr double kRevisitSpacingM = 0.1;  // a view is kept where no kept one is this near...

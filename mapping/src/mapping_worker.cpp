@@ -15,7 +15,6 @@
 namespace dynamap {
 namespace {
 
-constexpr double kDepthUnitsPerM = 5000.0;
 /// The held revision's confirmed-static and moved points: one per square of pixels as wide as a
 /// voxel at this depth (TUM's camera, 3 cm: 4 x 4 pixels; the 27 voxels around a held pixel still
 /// reach a point up to here).

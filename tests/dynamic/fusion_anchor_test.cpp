@@ -6,7 +6,7 @@
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
 
-namespace dynamap {
+namespace dynamap::fusion_anchor_test {
 namespace {
 
 const cv::Vec4d kK(535.4, 539.2, 320.1, 247.6);
@@ -193,4 +193,4 @@ TEST(FusionAnchors, FlagsOnAPersonKeptStillThatHisAnchorsDoNotConfirmAreHeldNotE
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::fusion_anchor_test

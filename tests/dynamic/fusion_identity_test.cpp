@@ -7,7 +7,7 @@
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
 
-namespace dynamap {
+namespace dynamap::fusion_identity_test {
 namespace {
 
 constexpr int kPerson = 0;
@@ -140,4 +140,4 @@ TEST(TrackIdentity, AConfirmedPersonsAnchorsFarOffInOneFrameOnlyDoNotRestartTheC
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::fusion_identity_test

@@ -7,7 +7,7 @@
 #include "dynamap/core/dynamic/region_fusion.hpp"
 #include "mask_share.hpp"
 
-namespace dynamap {
+namespace dynamap::fusion_time_test {
 namespace {
 
 constexpr int kPerson = 0;
@@ -227,9 +227,9 @@ TEST(FusionOverTime, APersonMaskedOnlyForLackOfQuietFramesIsHeldBackNotOneThatMo
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::fusion_time_test
 
-namespace dynamap {
+namespace dynamap::fusion_time_test {
 namespace {
 
 TEST(FusionOverTime, APersonWithoutPointsIsKeptWhenItsWorldPositionStaysPut) {
@@ -280,4 +280,4 @@ TEST(FusionOverTime, OneObjectWithTwoLabelsTakesItsBetterScoredClass) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::fusion_time_test

@@ -14,7 +14,7 @@
 #include "dynamap/core/tracker.hpp"
 #include "synthetic_scene.hpp"
 
-namespace dynamap {
+namespace dynamap::mover_tracks_test {
 namespace {
 
 constexpr double kFramePeriodS = 1.0 / 30.0;
@@ -113,4 +113,4 @@ TEST(MoverTracks, ALargeMoverCoveringHalfTheViewDoesNotPullThePose) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::mover_tracks_test

@@ -10,7 +10,7 @@
 
 #include "dynamap/core/dynamic/epipolar_check.hpp"
 
-namespace dynamap {
+namespace dynamap::rigid_prior_test {
 namespace {
 
 const cv::Vec4d kK(500, 500, 320, 240);
@@ -153,4 +153,4 @@ TEST(RigidCheckPrior, APriorTooFewMatchesAgreeWithIsNotTaken) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::rigid_prior_test

@@ -4,7 +4,7 @@
 #include "dynamap/core/dynamic/region_fusion.hpp"
 #include "dynamap/core/dynamic/support_planes.hpp"
 
-namespace dynamap {
+namespace dynamap::support_planes_test {
 namespace {
 
 // A camera 0.8 m above a floor, looking level at a wall 4 m away; a person (a flat board,
@@ -95,4 +95,4 @@ TEST(SupportPlanes, NoPlaneInAFrameOfClutter) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::support_planes_test

@@ -11,7 +11,7 @@
 #include "frame_prefetch.hpp"
 #include "test_paths.hpp"
 
-namespace dynamap {
+namespace dynamap::tum_dataset_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -297,4 +297,4 @@ TEST(TumSequenceRealData, UndistortsFreiburg1ButNotFreiburg3) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::tum_dataset_test

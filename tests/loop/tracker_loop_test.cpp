@@ -15,7 +15,7 @@
 #include "dynamap/core/tracker.hpp"
 #include "loop_test_scene.hpp"
 
-namespace dynamap {
+namespace dynamap::tracker_loop_test {
 namespace {
 
 constexpr double kStepDeg = 2.0;  ///< camera yaw per frame
@@ -144,4 +144,4 @@ TEST(TrackerLoopClosure, RealtimeCorrectionsLandConcurrently) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::tracker_loop_test

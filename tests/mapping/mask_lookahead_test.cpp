@@ -8,7 +8,7 @@
 
 #include "dynamap/mapping/mask_lookahead.hpp"
 
-namespace dynamap {
+namespace dynamap::mask_lookahead_test {
 namespace {
 
 struct Board {
@@ -126,4 +126,4 @@ TEST(MarginNotBehind, TheMarginLeavesTheWallBehindButKeepsTheOutlineHolesFloorAn
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::mask_lookahead_test

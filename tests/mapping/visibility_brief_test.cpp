@@ -10,7 +10,7 @@
 
 #include "visibility_pass.hpp"
 
-namespace dynamap::test {
+namespace dynamap::test::visibility_brief_test {
 namespace {
 
 constexpr int kKeyframes = 10;
@@ -99,4 +99,4 @@ TEST(VisibilityBrief, FloorTakenWithAFootStays) {
 }
 
 }  // namespace
-}  // namespace dynamap::test
+}  // namespace dynamap::test::visibility_brief_test

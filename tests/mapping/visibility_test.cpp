@@ -14,7 +14,7 @@
 #include "map_metrics.hpp"
 #include "mapping_test_utils.hpp"
 
-namespace dynamap::test {
+namespace dynamap::test::visibility_test {
 namespace {
 
 constexpr int kFrames = 12;
@@ -295,4 +295,4 @@ TEST(Visibility, AKeyframeWithoutStaticDepthOnlyVotes) {
 }
 
 }  // namespace
-}  // namespace dynamap::test
+}  // namespace dynamap::test::visibility_test

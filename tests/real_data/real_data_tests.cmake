@@ -10,7 +10,8 @@ foreach(case IN LISTS cases)
   add_test(NAME real_data.${case}
            COMMAND /usr/bin/python3 ${bands_py} check ${case} --dynamap $<TARGET_FILE:dynamap>
                    --work ${PROJECT_BINARY_DIR}/real_data)
-  set_tests_properties(real_data.${case} PROPERTIES LABELS real_data TIMEOUT 900)
+  set_tests_properties(real_data.${case} PROPERTIES LABELS real_data TIMEOUT 900
+                       COST 60)  # whole runs start first (tests/CMakeLists.txt, COST)
 endforeach()
 add_test(NAME real_data.band_logic COMMAND /usr/bin/python3 -m pytest -q
          ${CMAKE_CURRENT_LIST_DIR}/test_bands.py)

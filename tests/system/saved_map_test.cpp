@@ -16,7 +16,7 @@
 #include "synthetic_scene.hpp"
 #include "test_paths.hpp"
 
-namespace dynamap {
+namespace dynamap::saved_map_test {
 namespace {
 
 constexpr int kFrames = 60;
@@ -224,4 +224,4 @@ INSTANTIATE_TEST_SUITE_P(Volumes, SavedMapVolume, ::testing::ValuesIn(volumeBack
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SavedMapVolume);
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::saved_map_test

@@ -14,7 +14,7 @@
 #include "dynamap/system/config_schema.hpp"
 #include "test_paths.hpp"
 
-namespace dynamap {
+namespace dynamap::system_test {
 namespace {
 
 AppConfig fastConfig() {
@@ -168,4 +168,4 @@ TEST(System, ConfigAndBackendErrorsNameTheProblem) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::system_test

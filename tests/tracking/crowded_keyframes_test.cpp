@@ -8,7 +8,7 @@
 #include "synthetic_scene.hpp"
 #include "tracking_test_utils.hpp"
 
-namespace dynamap {
+namespace dynamap::crowded_keyframes_test {
 namespace {
 
 constexpr double kFramePeriodS = 1.0 / 30.0;
@@ -114,4 +114,4 @@ TEST(SyntheticTracking, AFrameTheMoversFillMakesAKeyframeBeforeItsTracksRunOut) 
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::crowded_keyframes_test

@@ -13,7 +13,7 @@
 #include "dynamap/core/camera.hpp"
 #include "dynamap/core/tracking/local_ba.hpp"
 
-namespace dynamap {
+namespace dynamap::local_ba_thread_test {
 namespace {
 
 constexpr int kKeyframes = 8;
@@ -152,4 +152,4 @@ TEST(SyntheticTracking, LocalBaThreadInLockstepWritesOnlyAtApplyFinished) {
 }
 
 }  // namespace
-}  // namespace dynamap
+}  // namespace dynamap::local_ba_thread_test

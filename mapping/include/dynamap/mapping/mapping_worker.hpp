@@ -80,11 +80,12 @@ class MappingWorker {
   std::unordered_map<std::uint64_t, cv::Mat> revisedMasks() const;
 
  private:
+  static constexpr double kDepthUnitsPerM = 5000.0;  ///< KeyframeRecord's 16-bit depths: 1/5000 m
   struct KeyframeRecord {
     double timestamp_s = 0.0;
     Eigen::Isometry3d T_integrated = Eigen::Isometry3d::Identity();
     Eigen::Isometry3d T_current = Eigen::Isometry3d::Identity();
-    cv::Mat depth_u16;  ///< static depth, 1/5000 m
+    cv::Mat depth_u16;  ///< static depth, 1 / kDepthUnitsPerM m
     cv::Mat bgr;
     VisibilityView view;  ///< options.visibility enabled only
     /// options.held_revision_voxel_m > 0 and held pixels only, until finish(): the held and
