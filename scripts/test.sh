@@ -7,7 +7,7 @@
 #      threads the shorter tests run too; scripts/sanitize.sh tsan alone runs every one).
 #      SANITIZERS="asan tsan" adds the whole suite under ASan + UBSan with the fuzzers' smoke
 #      run (FUZZ_SECONDS, default 10, each): about 25 minutes more on 2 cores.
-# CI (.ci/run) runs exactly this: ~23 minutes on 2 cores from a fresh clone (BENCHMARKS.md#ci).
+# CI (.ci/run) runs exactly this: ~20 minutes on 2 cores from a fresh clone (BENCHMARKS.md#ci).
 # Locally, SANITIZERS= (empty) skips 2.
 set -euo pipefail
 cd "$(dirname "$0")/.."
