@@ -36,17 +36,12 @@ struct LoopCloserConfig {
   PoseGraphOptions graph;
 };
 
-/// One keyframe's static features, as handed to LoopCloser::addKeyframe.
-struct LoopKeyframeInput {
-  std::uint64_t id = 0;
-  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;  ///< one 32-byte ORB row per keypoint
-  std::vector<double> depth_m;  ///< per keypoint, 0 = none
+/// One keyframe as handed to LoopCloser::addKeyframe: its features (landmark_ids optional,
+/// empty = none) and which of them are static; the loop closer keeps the static ones only.
+struct LoopKeyframeInput : LoopKeyframe {
   /// Per keypoint: 1 = static. 0 for every keypoint in a masked or held pixel, on a detected
   /// mover or on a landmark marked bad: those are dropped and never become loop evidence.
   std::vector<std::uint8_t> is_static;
-  std::vector<std::uint64_t> landmark_ids;  ///< optional, per keypoint (covisibility)
   /// The newest LoopCorrection::generation the tracker had applied to T_W_C (0 = none yet).
   int generation = 0;
 };
