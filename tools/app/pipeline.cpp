@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <exception>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -325,6 +326,14 @@ void Pipeline::finalize(RunResult& result) {
                                                         : "unknown");
   }
   result.keyframes = system.keyframes();
+  result.map_dir = (fs::path(options_.out_dir) / "map").string();
+  // The map first (a backend counts its elements as it exports); the counts even if it fails.
+  std::exception_ptr export_failed;
+  try {
+    system.exportMap(result.map_dir);
+  } catch (...) {
+    export_failed = std::current_exception();
+  }
   const SystemCounts counts = system.counts();
   result.counts.tracked = counts.tracked;
   result.counts.relocalized = counts.relocalized;
@@ -334,8 +343,7 @@ void Pipeline::finalize(RunResult& result) {
   result.counts.mapper_dropped = counts.mapper_dropped;
   result.counts.loaded_keyframes = counts.loaded_keyframes;
   result.counts.loaded_map_elements = counts.loaded_map_elements;
-  result.map_dir = (fs::path(options_.out_dir) / "map").string();
-  system.exportMap(result.map_dir);
+  if (export_failed) std::rethrow_exception(export_failed);
   if (!options_.save_map_dir.empty()) system.saveMap(options_.save_map_dir);  // after the outputs
 }
 
