@@ -14,10 +14,9 @@
 #include <pcl/filters/statistical_outlier_removal.h>
 
 #include "dynamap/mapping/backend_params.hpp"
-#include "dynamap/mapping/flat_index.hpp"
 #include "dynamap/mapping/in_two.hpp"
 #include "dynamap/mapping/plugin_api.hpp"
-#include "dynamap/mapping/radix_sort.hpp"
+#include "dynamap/mapping/voxel_block_index.hpp"
 #include "keyframe_voxels.hpp"
 #include "pcl_cloud_io.hpp"
 #include "voxel_key.hpp"
@@ -106,26 +105,19 @@ class PclVoxelBackend final : public MapBackend {
     plugin::KeyframeVoxels voxels;
   };
 
-  /// Points (camera frame) reduced to their world voxels' centroids, kept in the camera frame.
+  /// Points (camera frame) reduced to their world voxels' centroids, kept in the camera frame,
+  /// the voxels in the order of their first point (a surface walk: neighbours stay near).
   plugin::KeyframeVoxels reduce(const std::vector<Eigen::Vector3f>& pts,
                                 const std::vector<std::array<std::uint8_t, 3>>& colors,
-                                const Eigen::Isometry3d& T_W_C) {
+                                const Eigen::Isometry3d& T_W_C) const {
     const Eigen::Isometry3f T = T_W_C.cast<float>();
-    // Sort the points by world voxel: the runs are the reduced cloud.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      keyed[i] = {plugin::voxelKey(T * pts[i], inv_voxel_), static_cast<std::uint32_t>(i)};
-    }
-    radixSortByKey(keyed, scratch_, [](const auto& k) { return k.first; });
+    VoxelBlockIndex index(pts.size() / 4);
     std::vector<plugin::VoxelAccum> voxels_C;
-    for (std::size_t b = 0; b < keyed.size();) {
-      plugin::VoxelAccum run;
-      std::size_t e = b;
-      for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) {
-        run.add(pts[keyed[e].second], colors[keyed[e].second].data());
-      }
-      voxels_C.push_back(run);
-      b = e;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const std::uint64_t key = plugin::voxelKey(T * pts[i], inv_voxel_);
+      const auto slot = index.tryEmplace(key, static_cast<std::uint32_t>(voxels_C.size()));
+      if (slot.second) voxels_C.emplace_back();
+      voxels_C[slot.first].add(pts[i], colors[i].data());
     }
     return plugin::KeyframeVoxels(voxels_C);
   }
@@ -173,13 +165,13 @@ class PclVoxelBackend final : public MapBackend {
   }
 
   /// The map: every keyframe's voxels at its current pose, merged by world voxel. Two halves
-  /// of the world's voxels (by a hash of the key) are merged at once on two threads (inTwo),
-  /// each in the order of their first keyframe, the first half first. (With TBB here the reload
-  /// tests ran ~500 x slower under TSan than in Release; `points` ~20 x.)
+  /// of the world's voxels (by a hash of their 4 x 4 x 4 block) are merged at once on two
+  /// threads (inTwo), each in the order of their first keyframe, the first half first. (With TBB
+  /// here the reload tests ran ~500 x slower under TSan than in Release; `points` ~20 x.)
   std::vector<plugin::VoxelAccum> mergedVoxels() const {
     std::array<std::vector<plugin::VoxelAccum>, kMergeHalves> merged;
     inTwo([&](int half) {
-      FlatIndex index(expectedVoxels());
+      VoxelBlockIndex index(expectedVoxels());
       std::vector<plugin::VoxelAccum>& out = merged[static_cast<std::size_t>(half)];
       out.reserve(expectedVoxels());
       forEachPlacedVoxel([&](std::uint64_t key, const Eigen::Vector3f& p_W, const std::uint8_t* rgb,
@@ -199,7 +191,7 @@ class PclVoxelBackend final : public MapBackend {
   std::size_t distinctVoxels() const {
     std::array<std::size_t, kMergeHalves> count{};
     inTwo([&](int half) {
-      FlatIndex index(expectedVoxels());
+      VoxelBlockIndex index(expectedVoxels());
       forEachPlacedVoxel(
           [&](std::uint64_t key, const Eigen::Vector3f&, const std::uint8_t*, std::uint32_t) {
             if (halfOf(key) == half) index.tryEmplace(key, 0);
@@ -212,8 +204,8 @@ class PclVoxelBackend final : public MapBackend {
   }
 
   static constexpr int kMergeHalves = 2;  // inTwo()
-  static int halfOf(std::uint64_t key) {
-    return static_cast<int>((key * 0x9E3779B97F4A7C15ull) >> 63);  // Fibonacci hash, top bit
+  static int halfOf(std::uint64_t key) {  // Fibonacci hash of the block, top bit
+    return static_cast<int>((VoxelBlockIndex::blockOf(key) * 0x9E3779B97F4A7C15ull) >> 63);
   }
   /// Distinct voxels expected in one half (5 % margin): the map's if known, else 2/3 of the
   /// placed ones. Too few costs a regrowth of the half's index and voxels.
@@ -227,7 +219,6 @@ class PclVoxelBackend final : public MapBackend {
   int min_points_ = 1;
   int sor_k_ = 0;
   double sor_stddev_ = 1.0;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> scratch_;  ///< integrate()'s sort
   int resident_keyframes_ = 32;
   std::unique_ptr<plugin::SpillFile<plugin::CompactVoxel>> spill_;  ///< made at the first spill
   std::map<std::uint64_t, Keyframe> keyframes_;
