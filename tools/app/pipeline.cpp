@@ -4,8 +4,8 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <exception>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
