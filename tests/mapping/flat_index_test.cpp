@@ -13,14 +13,10 @@
 namespace dynamap::test {
 namespace {
 
-TEST(FlatIndex, AnswersAsUnorderedMapForVoxelKeysThroughGrowth) {
-  std::mt19937_64 rng(11);
-  std::uniform_int_distribution<int> axis(-40, 40);  // many repeats: ~530 k cells, 200 k draws
-  const auto key = [&] {
-    const auto c = [&] { return static_cast<std::uint64_t>(axis(rng) + (1 << 20)); };
-    return c() | (c() << 21) | (c() << 42);  // as voxelKey() packs them
-  };
-  FlatIndex index(4);  // grows many times
+/// Fills `index` with 200 k draws of `key()` beside an unordered_map, then probes 100 k more:
+/// every insertion and every lookup answers as the map does.
+template <typename Index, typename KeyFn>
+void expectAnswersAsUnorderedMap(Index& index, KeyFn&& key) {
   std::unordered_map<std::uint64_t, std::uint32_t> reference;
   for (std::uint32_t i = 0; i < 200000; ++i) {
     const std::uint64_t k = key();
@@ -33,8 +29,19 @@ TEST(FlatIndex, AnswersAsUnorderedMapForVoxelKeysThroughGrowth) {
   for (int probe = 0; probe < 100000; ++probe) {
     const std::uint64_t k = key();
     const auto it = reference.find(k);
-    EXPECT_EQ(index.find(k), it == reference.end() ? FlatIndex::kMissing : it->second);
+    EXPECT_EQ(index.find(k), it == reference.end() ? Index::kMissing : it->second);
   }
+}
+
+TEST(FlatIndex, AnswersAsUnorderedMapForVoxelKeysThroughGrowth) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> axis(-40, 40);  // many repeats: ~530 k cells, 200 k draws
+  const auto key = [&] {
+    const auto c = [&] { return static_cast<std::uint64_t>(axis(rng) + (1 << 20)); };
+    return c() | (c() << 21) | (c() << 42);  // as voxelKey() packs them
+  };
+  FlatIndex index(4);  // grows many times
+  expectAnswersAsUnorderedMap(index, key);
   // Keys 0 and neighbours of the reserved empty key are ordinary keys.
   EXPECT_EQ(index.find(0), FlatIndex::kMissing);
   EXPECT_TRUE(index.tryEmplace(0, 7).second);
@@ -52,20 +59,7 @@ TEST(VoxelBlockIndex, AnswersAsUnorderedMapForCellsAcrossBlocksAndTheWrap) {
     return static_cast<std::int64_t>(axis(rng) + wrap);
   };
   VoxelBlockIndex index(4);  // its blocks and cells grow many times
-  std::unordered_map<std::uint64_t, std::uint32_t> reference;
-  for (std::uint32_t i = 0; i < 200000; ++i) {
-    const std::uint64_t k = packVoxelKey(cell(), cell(), cell());
-    const auto [value, inserted] = index.tryEmplace(k, i);
-    const auto [it, ref_inserted] = reference.try_emplace(k, i);
-    ASSERT_EQ(inserted, ref_inserted);
-    ASSERT_EQ(value, it->second);
-  }
-  EXPECT_EQ(index.size(), reference.size());
-  for (int probe = 0; probe < 100000; ++probe) {
-    const std::uint64_t k = packVoxelKey(cell(), cell(), cell());
-    const auto it = reference.find(k);
-    EXPECT_EQ(index.find(k), it == reference.end() ? VoxelBlockIndex::kMissing : it->second);
-  }
+  expectAnswersAsUnorderedMap(index, [&] { return packVoxelKey(cell(), cell(), cell()); });
 }
 
 TEST(VoxelBlockIndex, BlocksAreTheAlignedFourCubedCells) {
