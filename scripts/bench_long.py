@@ -5,10 +5,12 @@ frames/s, masks and map, for sequences played N times forward and backward by
 
 Usage: bench_long.py [--dynamap BIN] [--out DIR] [--cases a,b] [--backends b1,b2] [--passes N]
 Prints a markdown table (one row per case and backend: the single pass, the long run and their
-ratios) and writes it to OUT/long.md. The long sequences are made under /tmp on first use.
+ratios, and the keyframes each pass of the long run added: where the growth is) and writes it
+to OUT/long.md. The long sequences are made under /tmp on first use.
 Standard library only (make_long.py needs Debian's numpy).
 """
 import argparse
+import bisect
 import os
 import subprocess
 import sys
@@ -38,6 +40,43 @@ def long_sequence(name, passes):
         subprocess.run(["/usr/bin/python3", f"{SHARED}/tools/make_long.py", src, out,
                         ",".join(ends)], check=True, stdout=subprocess.DEVNULL)
     return out
+
+
+def timestamps(path):
+    """The first column of a TUM-format list (rgb.txt, keyframes.txt), comments skipped."""
+    with open(path) as f:
+        return [float(line.split()[0]) for line in f if line.strip() and line[0] != "#"]
+
+
+def pass_starts(seq):
+    """The timestamps at which each pass of a make_long.py sequence starts: where the source
+    frames its images link to turn from forward to backward or back."""
+    stamps, source = [], []
+    with open(os.path.join(seq, "rgb.txt")) as f:
+        for line in f:
+            if not line.strip() or line[0] == "#":
+                continue
+            stamp, name = line.split()[:2]
+            target = os.path.basename(os.readlink(os.path.join(seq, name)))
+            stamps.append(float(stamp))
+            source.append(float(os.path.splitext(target)[0]))
+    starts, direction = [stamps[0]], 0.0
+    for i in range(1, len(source)):
+        step = source[i] - source[i - 1]
+        if step * direction < 0:
+            starts.append(stamps[i - 1])
+        if step != 0:
+            direction = step
+    return starts
+
+
+def keyframes_per_pass(out, starts):
+    """How many keyframes the run made in each pass (a list as long as `starts`)."""
+    counts = [0] * len(starts)
+    kf_file = os.path.join(out, "keyframes.txt")
+    for t in timestamps(kf_file) if os.path.isfile(kf_file) else []:
+        counts[max(0, bisect.bisect_right(starts, t) - 1)] += 1
+    return counts
 
 
 def run(dynamap, seq, out, options):
@@ -77,7 +116,8 @@ def row(case, backend, one, many):
              f"{fmt(one['fps'], 1)} / {fmt(many['fps'], 1)}",
              f"{fmt(one['iou'], 3)} / {fmt(many['iou'], 3)}",
              f"{fmt(one['precision'], 3)} / {fmt(many['precision'], 3)}",
-             f"{fmt(one['ghost'], 3)} / {fmt(many['ghost'], 3)}"]
+             f"{fmt(one['ghost'], 3)} / {fmt(many['ghost'], 3)}",
+             ", ".join(str(n) for n in many["per_pass"])]
     return "| " + " | ".join(cells) + " |"
 
 
@@ -92,7 +132,8 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     header = ("| case | backend | frames 1 / N | keyframes (x) | peak MiB (x) | ATE cm (x) | "
-              "finish s | frames/s | mask IoU | map precision | ghost |\n" + "|---" * 11 + "|")
+              "finish s | frames/s | mask IoU | map precision | ghost | new keyframes per pass |\n" +
+              "|---" * 12 + "|")
     lines = [header]
     for case in a.cases.split(","):
         src, _, options = CASES[case]
@@ -104,7 +145,9 @@ def main():
             for kv in a.set:
                 opts += ["--set", kv]
             one = run(a.dynamap, src, f"{a.out}/{case}__{backend}__x1", opts)
-            many = run(a.dynamap, seq_long, f"{a.out}/{case}__{backend}__x{a.passes}", opts)
+            out_long = f"{a.out}/{case}__{backend}__x{a.passes}"
+            many = run(a.dynamap, seq_long, out_long, opts)
+            many["per_pass"] = keyframes_per_pass(out_long, pass_starts(seq_long))
             lines.append(row(case, backend, one, many))
             print(lines[-1], flush=True)
     with open(os.path.join(a.out, "long.md"), "w") as f:
