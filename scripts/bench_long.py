@@ -42,24 +42,19 @@ def long_sequence(name, passes):
     return out
 
 
-def timestamps(path):
-    """The first column of a TUM-format list (rgb.txt, keyframes.txt), comments skipped."""
+def tum_rows(path):
+    """The fields of each line of a TUM-format list (rgb.txt, keyframes.txt), comments skipped."""
     with open(path) as f:
-        return [float(line.split()[0]) for line in f if line.strip() and line[0] != "#"]
+        return [line.split() for line in f if line.strip() and line[0] != "#"]
 
 
 def pass_starts(seq):
     """The timestamps at which each pass of a make_long.py sequence starts: where the source
     frames its images link to turn from forward to backward or back."""
-    stamps, source = [], []
-    with open(os.path.join(seq, "rgb.txt")) as f:
-        for line in f:
-            if not line.strip() or line[0] == "#":
-                continue
-            stamp, name = line.split()[:2]
-            target = os.path.basename(os.readlink(os.path.join(seq, name)))
-            stamps.append(float(stamp))
-            source.append(float(os.path.splitext(target)[0]))
+    rows = tum_rows(os.path.join(seq, "rgb.txt"))
+    stamps = [float(r[0]) for r in rows]
+    source = [float(os.path.splitext(os.path.basename(os.readlink(os.path.join(seq, r[1]))))[0])
+              for r in rows]
     starts, direction = [stamps[0]], 0.0
     for i in range(1, len(source)):
         step = source[i] - source[i - 1]
@@ -74,8 +69,8 @@ def keyframes_per_pass(out, starts):
     """How many keyframes the run made in each pass (a list as long as `starts`)."""
     counts = [0] * len(starts)
     kf_file = os.path.join(out, "keyframes.txt")
-    for t in timestamps(kf_file) if os.path.isfile(kf_file) else []:
-        counts[max(0, bisect.bisect_right(starts, t) - 1)] += 1
+    for r in tum_rows(kf_file) if os.path.isfile(kf_file) else []:
+        counts[max(0, bisect.bisect_right(starts, float(r[0])) - 1)] += 1
     return counts
 
 
@@ -138,6 +133,7 @@ def main():
     for case in a.cases.split(","):
         src, _, options = CASES[case]
         seq_long = long_sequence(case, a.passes)
+        starts = pass_starts(seq_long)
         for backend in a.backends.split(","):
             opts = list(options)
             if backend != "default":
@@ -147,7 +143,7 @@ def main():
             one = run(a.dynamap, src, f"{a.out}/{case}__{backend}__x1", opts)
             out_long = f"{a.out}/{case}__{backend}__x{a.passes}"
             many = run(a.dynamap, seq_long, out_long, opts)
-            many["per_pass"] = keyframes_per_pass(out_long, pass_starts(seq_long))
+            many["per_pass"] = keyframes_per_pass(out_long, starts)
             lines.append(row(case, backend, one, many))
             print(lines[-1], flush=True)
     with open(os.path.join(a.out, "long.md"), "w") as f:
