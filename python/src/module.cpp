@@ -164,6 +164,7 @@ PYBIND11_MODULE(dynamap, m) {
             d["relocalized"] = c.relocalized;
             d["lost"] = c.lost;
             d["keyframes"] = c.keyframes;
+            d["culled_keyframes"] = c.culled_keyframes;
             d["mapped_keyframes"] = c.mapped_keyframes;
             d["map_elements"] = c.map_elements;
             d["loaded_keyframes"] = c.loaded_keyframes;

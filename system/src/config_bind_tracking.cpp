@@ -52,6 +52,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_reuse_min_age_s", &c.kf_reuse_min_age_s, 0.0, 1e9);
   schema.addInt("tracking.kf_reuse_orb_features", &c.kf_reuse_orb_features, 1, 100000);
   schema.addInt("tracking.kf_reuse_orb_fast_threshold", &c.kf_reuse_orb_fast_threshold, 1, 255);
+  schema.addBool("tracking.kf_cull_redundant", &c.kf_cull_redundant);
 
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);

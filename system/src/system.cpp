@@ -262,7 +262,9 @@ std::vector<FrameStatus> System::frameStatuses() const {
 std::vector<TimedPose> System::keyframes() const {
   if (!impl_->tracker) return impl_->given_trajectory;
   std::vector<TimedPose> poses;
-  for (const auto& kf : impl_->tracker->keyframes()) poses.push_back({kf.timestamp_s, kf.T_W_C});
+  for (const auto& kf : impl_->tracker->keyframes()) {
+    if (!kf.culled) poses.push_back({kf.timestamp_s, kf.T_W_C});
+  }
   return poses;
 }
 
@@ -274,7 +276,8 @@ SystemCounts System::counts() const {
     c.tracked = stats.tracked;
     c.relocalized = stats.relocalized;
     c.lost = stats.lost;
-    c.keyframes = stats.keyframes;
+    c.keyframes = stats.keyframes - stats.culled_keyframes;
+    c.culled_keyframes = stats.culled_keyframes;
   } else {
     c.tracked = s.given_trajectory.size();
   }

@@ -1,6 +1,7 @@
 // LocalMap (core/src/tracking/local_map.cpp): dense ids and keyframe counts, the relocalization
 // candidates of the newest keyframes, the bundle-adjustment window (which keyframes are free,
-// which held fixed, which landmarks) and writing a solved window back.
+// which held fixed, which landmarks), writing a solved window back, and culled keyframes (out of
+// every list, following their parent's pose).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,6 +142,81 @@ TEST(LocalMap, ApplyWritesFreePosesAndPointsAndReportsOnlyMovedKeyframes) {
   EXPECT_EQ(points[1], Eigen::Vector3d(8, 0, 3.5));
   EXPECT_EQ(points[2], Eigen::Vector3d(9, 0, 3.5));
   EXPECT_EQ(points[3], Eigen::Vector3d(6, 0, 3));  // not in the window
+}
+
+TEST(LocalMap, CullRefusesTheFirstKeyframeANewerParentAndCulledOnes) {
+  LocalMap map;
+  buildMap(map);
+  EXPECT_FALSE(map.cull(0, 0));  // keyframe 0 defines the world
+  EXPECT_FALSE(map.cull(1, 2));  // the parent must be older
+  EXPECT_FALSE(map.cull(9, 0));  // no such keyframe
+  EXPECT_TRUE(map.cull(2, 1));
+  EXPECT_FALSE(map.cull(2, 0));  // already culled
+  EXPECT_FALSE(map.cull(3, 2));  // a culled parent
+  EXPECT_TRUE(map.isCulled(2));
+  EXPECT_FALSE(map.isCulled(3));
+  EXPECT_EQ(map.keyframeCount(), 4u);  // ids stay dense
+}
+
+TEST(LocalMap, CulledKeyframeLeavesNearbyRelocWindowAndSavedMap) {
+  LocalMap map;
+  buildMap(map);
+  ASSERT_TRUE(map.cull(2, 1));
+  const auto near = map.keyframesNear(poseOf(2), 1.0, 10.0);
+  EXPECT_EQ(sorted(near), (std::vector<std::uint64_t>{0, 1, 3}));
+  std::vector<std::uint64_t> ids;
+  cv::Mat descriptors;
+  std::vector<Eigen::Vector3d> points;
+  map.relocCandidates(2, ids, descriptors, points);  // kf3 and (culled) kf2: kf3's only
+  EXPECT_EQ(sorted(ids), (std::vector<std::uint64_t>{7, 8}));
+  const BaWindow w = map.snapshotWindow(4, 1);
+  EXPECT_EQ(std::count(w.keyframe_ids.begin(), w.keyframe_ids.end(), 2u), 0);
+  // Its observations (landmarks 5 6 7) constrain its parent, through the fixed offset.
+  int attached = 0;
+  for (const auto& o : w.observations) {
+    EXPECT_NE(w.keyframe_ids[o.keyframe], 2u);
+    if (o.attached < 0) continue;
+    ++attached;
+    EXPECT_EQ(w.keyframe_ids[o.keyframe], 1u);
+  }
+  EXPECT_EQ(attached, 3);
+  ASSERT_EQ(w.attached.size(), 1u);
+  EXPECT_TRUE(w.attached[0].isApprox(poseOf(2).inverse() * poseOf(1), 1e-12));
+  const MapContents saved = map.contents();
+  ASSERT_EQ(saved.keyframes.size(), 3u);
+  for (std::size_t k = 0; k < saved.keyframes.size(); ++k) {
+    EXPECT_EQ(saved.keyframes[k].id, k);  // renumbered densely
+  }
+  EXPECT_DOUBLE_EQ(saved.keyframes[2].timestamp_s, 1.5);  // kf3
+  const auto kfs = map.keyframes();
+  ASSERT_EQ(kfs.size(), 4u);  // every keyframe, culled ones flagged
+  EXPECT_TRUE(kfs[2].culled);
+  EXPECT_FALSE(kfs[3].culled);
+}
+
+TEST(LocalMap, CulledKeyframeFollowsItsParentThroughBundleAdjustment) {
+  LocalMap map;
+  buildMap(map);
+  ASSERT_TRUE(map.cull(2, 1));
+  BaWindow w = map.snapshotWindow(4, 1);  // kf0 fixed; kf1, kf3 free
+  Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+  moved.translation() = Eigen::Vector3d(0.0, 0.03, 0.0);
+  moved.linear() = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (std::size_t k = 0; k < w.keyframe_ids.size(); ++k) {
+    if (w.keyframe_ids[k] == 1) w.poses[k] = moved * w.poses[k];
+  }
+  const std::vector<PoseUpdate> updates = map.apply(w);
+  const auto update_of = [&](std::uint64_t id) {
+    return std::find_if(updates.begin(), updates.end(),
+                        [id](const PoseUpdate& u) { return u.keyframe_id == id; });
+  };
+  ASSERT_NE(update_of(2), updates.end());  // the culled one moved with its parent
+  const Eigen::Isometry3d expected = moved * poseOf(2);
+  EXPECT_TRUE(update_of(2)->T_W_C.isApprox(expected, 1e-9));
+  EXPECT_TRUE(map.keyframePose(2).isApprox(expected, 1e-9));
+  // The relative pose to the parent is what it was when culled.
+  EXPECT_TRUE((map.keyframePose(1).inverse() * map.keyframePose(2))
+                  .isApprox(poseOf(1).inverse() * poseOf(2), 1e-9));
 }
 
 }  // namespace

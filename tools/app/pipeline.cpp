@@ -339,6 +339,7 @@ void Pipeline::finalize(RunResult& result) {
   result.counts.relocalized = counts.relocalized;
   result.counts.lost = counts.lost;
   result.counts.keyframes = counts.keyframes;
+  result.counts.culled_keyframes = counts.culled_keyframes;
   result.counts.mapped_keyframes = counts.mapped_keyframes;
   result.counts.mapper_dropped = counts.mapper_dropped;
   result.counts.loaded_keyframes = counts.loaded_keyframes;

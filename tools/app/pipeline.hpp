@@ -27,7 +27,8 @@ struct RunCounts {
   std::size_t relocalized = 0;
   std::size_t lost = 0;
   std::size_t bad_frames = 0;
-  std::size_t keyframes = 0;
+  std::size_t keyframes = 0;         ///< kept (SystemCounts::keyframes)
+  std::size_t culled_keyframes = 0;  ///< made, then culled as redundant
   std::size_t mapped_keyframes = 0;
   std::size_t skipped_realtime = 0;  ///< --realtime: frames skipped because tracking lagged
   std::size_t mapper_dropped = 0;    ///< --realtime: keyframes the busy mapper did not take

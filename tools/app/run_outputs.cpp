@@ -74,6 +74,7 @@ void writeRunJson(const std::string& out_dir, const RunResult& result) {
                  {"lost", c.lost},
                  {"bad_frames", c.bad_frames},
                  {"keyframes", c.keyframes},
+                 {"culled_keyframes", c.culled_keyframes},
                  {"mapped_keyframes", c.mapped_keyframes},
                  {"skipped_realtime", c.skipped_realtime},
                  {"mapper_dropped", c.mapper_dropped}};
@@ -150,8 +151,8 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
   const RunCounts& c = result.counts;
   out << "run " << result.status << ": " << c.frames_read << " frames read, " << c.tracked
       << " tracked, " << c.relocalized << " relocalized, " << c.lost << " lost, " << c.bad_frames
-      << " bad; " << c.keyframes << " keyframes; " << report.frames_per_s << " frames/s ("
-      << result.finish_s << " s of it finishing)\n";
+      << " bad; " << c.keyframes << " keyframes (" << c.culled_keyframes << " more culled); "
+      << report.frames_per_s << " frames/s (" << result.finish_s << " s of it finishing)\n";
   if (!result.error.empty()) out << "error: " << result.error << "\n";
   if (report.evaluation) out << evaluationToTable(*report.evaluation);
   if (!report.map_metrics_json.empty()) out << "map: " << report.map_metrics_json << "\n";

@@ -22,9 +22,16 @@ bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& con
     const double inv_sigma_z = config.use_depth_residual && o.depth_m > 0.0
                                    ? 1.0 / depthSigma(config.depth_sigma_coeff, o.depth_m)
                                    : 0.0;
-    auto* cost = new ceres::AutoDiffCostFunction<RgbdResidual, 3, 6, 3>(
-        new RgbdResidual(camera, o.px, config.use_depth_residual ? o.depth_m : 0.0,
-                         1.0 / config.pixel_sigma_px, inv_sigma_z));
+    const RgbdResidual residual(camera, o.px, config.use_depth_residual ? o.depth_m : 0.0,
+                                1.0 / config.pixel_sigma_px, inv_sigma_z);
+    ceres::CostFunction* cost = nullptr;
+    if (o.attached < 0) {
+      cost = new ceres::AutoDiffCostFunction<RgbdResidual, 3, 6, 3>(new RgbdResidual(residual));
+    } else {
+      cost =
+          new ceres::AutoDiffCostFunction<RgbdAttachedResidual, 3, 6, 3>(new RgbdAttachedResidual(
+              residual, window.attached[static_cast<std::size_t>(o.attached)]));
+    }
     problem.AddResidualBlock(cost, &loss, poses[static_cast<std::size_t>(o.keyframe)].data(),
                              window.points[static_cast<std::size_t>(o.landmark)].data());
   }

@@ -36,6 +36,35 @@ std::size_t LocalMap::keyframeCount() const {
   return keyframes_.size();
 }
 
+bool LocalMap::cull(std::uint64_t id, std::uint64_t parent) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (id == 0 || parent >= id || id >= keyframes_.size()) return false;
+  MapKeyframe& kf = keyframes_[id];
+  const MapKeyframe& to = keyframes_[parent];
+  if (kf.culled || kf.loaded || to.culled) return false;
+  kf.culled = true;
+  kf.parent = parent;
+  kf.T_parent_C = to.T_W_C.inverse() * kf.T_W_C;
+  keyframes_[parent].culled_children.push_back(id);
+  culled_.push_back(id);
+  return true;
+}
+
+bool LocalMap::isCulled(std::uint64_t id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return keyframes_.at(id).culled;
+}
+
+void LocalMap::followParentsLocked(std::vector<PoseUpdate>& updates) {
+  for (const auto id : culled_) {
+    MapKeyframe& kf = keyframes_[id];
+    const Eigen::Isometry3d T_W_C = keyframes_[kf.parent].T_W_C * kf.T_parent_C;
+    if (T_W_C.isApprox(kf.T_W_C, 1e-12)) continue;
+    kf.T_W_C = T_W_C;
+    updates.push_back(PoseUpdate{id, T_W_C});
+  }
+}
+
 Eigen::Isometry3d LocalMap::keyframePose(std::uint64_t id) const {
   std::lock_guard<std::mutex> lock(mutex_);
   return keyframes_.at(id).T_W_C;
@@ -87,27 +116,42 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
   const int first = std::max(0, first_opt - window);
   const int first_free = std::max(first_opt + fixed, 1);  // keyframe 0 defines the world
   if (first_free >= n) return w;
+  // A keyframe's own observations, then those of the keyframes culled into it (attached).
+  const auto each_observation = [this](const MapKeyframe& kf, const auto& fn) {
+    for (const auto& o : kf.observations) fn(o, static_cast<const MapKeyframe*>(nullptr));
+    for (const auto child : kf.culled_children) {
+      for (const auto& o : keyframes_[child].observations) fn(o, &keyframes_[child]);
+    }
+  };
   std::unordered_map<std::uint64_t, int> lm_index;
   for (int k = first_free; k < n; ++k) {
-    for (const auto& o : keyframes_[static_cast<std::size_t>(k)].observations) {
-      if (landmarks_[o.landmark_id].bad) continue;
+    const auto& kf = keyframes_[static_cast<std::size_t>(k)];
+    if (kf.culled) continue;
+    each_observation(kf, [&](const KeyframeObservation& o, const MapKeyframe*) {
+      if (landmarks_[o.landmark_id].bad) return;
       if (lm_index.emplace(o.landmark_id, static_cast<int>(w.landmark_ids.size())).second) {
         w.landmark_ids.push_back(o.landmark_id);
         w.points.push_back(landmarks_[o.landmark_id].p_W);
       }
-    }
+    });
   }
   for (int k = first; k < n; ++k) {
     const auto& kf = keyframes_[static_cast<std::size_t>(k)];
+    if (kf.culled) continue;
     const int kf_index = static_cast<int>(w.keyframe_ids.size());
-    bool any = false;
-    for (const auto& o : kf.observations) {
+    const std::size_t observations_before = w.observations.size();
+    const MapKeyframe* last_child = nullptr;
+    each_observation(kf, [&](const KeyframeObservation& o, const MapKeyframe* child) {
       auto it = lm_index.find(o.landmark_id);
-      if (it == lm_index.end()) continue;
-      w.observations.push_back({kf_index, it->second, o.px, o.depth_m});
-      any = true;
-    }
-    if (!any) continue;
+      if (it == lm_index.end()) return;
+      if (child != nullptr && child != last_child) {
+        w.attached.push_back(child->T_parent_C.inverse());
+        last_child = child;
+      }
+      const int attached = child == nullptr ? -1 : static_cast<int>(w.attached.size()) - 1;
+      w.observations.push_back({kf_index, it->second, o.px, o.depth_m, attached});
+    });
+    if (w.observations.size() == observations_before) continue;
     w.keyframe_ids.push_back(kf.id);
     w.poses.push_back(kf.T_W_C);
     w.fixed.push_back(k < first_free || kf.loaded ? 1 : 0);  // a loaded map stays put
@@ -127,6 +171,7 @@ std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
   for (std::size_t i = 0; i < solved.landmark_ids.size(); ++i) {
     landmarks_[solved.landmark_ids[i]].p_W = solved.points[i];
   }
+  followParentsLocked(updates);
   return updates;
 }
 
@@ -154,8 +199,10 @@ std::vector<PoseUpdate> LocalMap::applyLoopCorrection(const LoopCorrection& corr
   updates.reserve(keyframes_.size());
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     keyframes_[k].T_W_C = move_of[k] * keyframes_[k].T_W_C;
-    updates.push_back(PoseUpdate{keyframes_[k].id, keyframes_[k].T_W_C});
   }
+  std::vector<PoseUpdate> ignored;  // every keyframe is listed below anyway
+  followParentsLocked(ignored);
+  for (const auto& kf : keyframes_) updates.push_back(PoseUpdate{kf.id, kf.T_W_C});
   generation_ = correction.generation;
   return updates;
 }
@@ -171,7 +218,8 @@ void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, c
   std::vector<std::uint64_t> newest;
   const int n = static_cast<int>(keyframes_.size());
   for (int k = n - 1; k >= std::max(0, n - keyframes); --k) {
-    newest.push_back(static_cast<std::uint64_t>(k));
+    if (!keyframes_[static_cast<std::size_t>(k)].culled)
+      newest.push_back(static_cast<std::uint64_t>(k));
   }
   LandmarkCandidates c = landmarksOfLocked(newest);
   ids = std::move(c.ids);
@@ -183,7 +231,9 @@ std::vector<KeyframeInfo> LocalMap::keyframes() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<KeyframeInfo> out;
   out.reserve(keyframes_.size());
-  for (const auto& kf : keyframes_) out.push_back(KeyframeInfo{kf.id, kf.timestamp_s, kf.T_W_C});
+  for (const auto& kf : keyframes_) {
+    out.push_back(KeyframeInfo{kf.id, kf.timestamp_s, kf.T_W_C, kf.culled});
+  }
   return out;
 }
 
@@ -194,7 +244,7 @@ std::vector<std::uint64_t> LocalMap::keyframesNear(const Eigen::Isometry3d& T_W_
   std::vector<std::pair<double, std::uint64_t>> near;
   const double max_rotation_rad = max_rotation_deg * M_PI / 180.0;
   for (const auto& kf : keyframes_) {
-    if (kf.timestamp_s > latest_s && !kf.loaded) continue;
+    if (kf.culled || (kf.timestamp_s > latest_s && !kf.loaded)) continue;
     const Eigen::Isometry3d T_kf_C = kf.T_W_C.inverse() * T_W_C;
     const double distance = std::max(T_kf_C.translation().norm() / max_translation_m,
                                      Eigen::AngleAxisd(T_kf_C.linear()).angle() / max_rotation_rad);
@@ -216,8 +266,8 @@ LandmarkCandidates LocalMap::landmarksOfLocked(
     const std::vector<std::uint64_t>& keyframe_ids) const {
   LandmarkCandidates out;
   std::unordered_set<std::uint64_t> seen;
-  for (const auto k : keyframe_ids) {
-    for (const auto& o : keyframes_.at(k).observations) {
+  const auto add = [&](const MapKeyframe& kf) {
+    for (const auto& o : kf.observations) {
       if (!seen.insert(o.landmark_id).second) continue;
       const Landmark& lm = landmarks_[o.landmark_id];
       if (lm.descriptor.empty() || lm.bad) continue;
@@ -225,13 +275,25 @@ LandmarkCandidates LocalMap::landmarksOfLocked(
       out.points.push_back(lm.p_W);
       out.descriptors.push_back(lm.descriptor);
     }
+  };
+  for (const auto k : keyframe_ids) {
+    const MapKeyframe& kf = keyframes_.at(k);
+    add(kf);
+    for (const auto child : kf.culled_children) add(keyframes_[child]);
   }
   return out;
 }
 
 MapContents LocalMap::contents() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return MapContents{landmarks_, keyframes_};
+  MapContents out{landmarks_, {}};
+  out.keyframes.reserve(keyframes_.size() - culled_.size());
+  for (const auto& kf : keyframes_) {
+    if (kf.culled) continue;
+    out.keyframes.push_back(kf);
+    out.keyframes.back().id = out.keyframes.size() - 1;
+  }
+  return out;
 }
 
 void LocalMap::restore(MapContents contents) {
@@ -239,6 +301,7 @@ void LocalMap::restore(MapContents contents) {
   std::lock_guard<std::mutex> lock(mutex_);
   landmarks_ = std::move(contents.landmarks);
   keyframes_ = std::move(contents.keyframes);
+  culled_.clear();
 }
 
 std::size_t LocalMap::observationCount(std::uint64_t keyframe_id) const {

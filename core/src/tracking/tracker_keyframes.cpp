@@ -157,6 +157,9 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
                                                 Eigen::Isometry3d& T_W_C,
                                                 const MotionFilterOutput& filtered,
                                                 const cv::Mat& track_mask) {
+  std::uint64_t redundant_parent = 0;
+  const bool redundant = coveredByOlderKeyframes(frame, gray, track_mask, certainMask(filtered),
+                                                 T_W_C, redundant_parent);
   const OrbFeatures features = extractOrb(gray, track_mask);
   const double max_landmark_m = std::min(config_.depth_max_m, config_.landmark_depth_max_m);
   std::vector<double> depth(features.keypoints.size());
@@ -209,6 +212,8 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
   const std::uint64_t kf_id =
       map_.addKeyframe(frame.timestamp_s, T_W_C, std::move(observations), maskedShare(movers),
                        staticCells(movers, camera_.width, camera_.height));
+  if (redundant) redundant_into_[kf_id] = redundant_parent;
+  cullRedundantKeyframe(kf_id);
   ref_kf_ = kf_id;
   ref_T_W_C_ = T_W_C;
   ref_timestamp_s_ = frame.timestamp_s;

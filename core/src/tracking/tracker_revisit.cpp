@@ -3,6 +3,8 @@
 // of new landmarks beside the old ones. Keyframes grow with the space explored, not with time.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <unordered_set>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
@@ -101,6 +103,10 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(
   return found;
 }
 
+std::vector<std::uint64_t> Tracker::Impl::reuseSourcesAll(const Eigen::Isometry3d& T_W_C) const {
+  return map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
+}
+
 std::vector<std::uint64_t> Tracker::Impl::reuseSources(const Eigen::Isometry3d& T_W_C) const {
   std::vector<std::uint64_t> near =
       map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
@@ -120,6 +126,67 @@ double Tracker::Impl::uncoveredView(const RgbdFrame& frame, const cv::Mat& mover
   query.depth_min_m = config_.depth_min_m;
   query.depth_max_m = config_.depth_max_m;
   return uncoveredShare(query, map_.coverageViews(near));
+}
+
+// A keyframe about to be made where older keyframes, outside the bundle-adjustment window,
+// already cover the view (a revisit reuseKeyframe() did not take: the old keyframes were too
+// recent then, or the frame needed fresh landmarks to keep tracking) is redundant if their
+// landmarks alone pose the frame where its own tracks do: then its fresh landmarks add nothing
+// and no drift between it and the old map is locked in when it follows its parent.
+bool Tracker::Impl::coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Mat& gray,
+                                            const cv::Mat& track_mask, const cv::Mat& movers,
+                                            const Eigen::Isometry3d& T_W_C, std::uint64_t& parent) {
+  if (!config_.kf_cull_redundant || config_.ba_window <= 0 || !initialized_) return false;
+  const std::size_t window = static_cast<std::size_t>(config_.ba_window);
+  const std::size_t n = map_.keyframeCount();  // the id the new keyframe will have
+  if (n <= window) return false;
+  ScopedStageTimer timer(timings_, "keyframe_cull");
+  std::vector<std::uint64_t> sources;
+  for (const auto k : reuseSourcesAll(T_W_C)) {
+    if (k < n - window && sources.size() < kReuseSourceKeyframes) sources.push_back(k);
+  }
+  if (sources.empty() ||
+      uncoveredView(frame, movers, T_W_C, sources) > config_.kf_reuse_max_uncovered_share) {
+    return false;
+  }
+  // The old landmarks the frame sees: those it tracks and those found among its keypoints.
+  const LandmarkCandidates old = map_.landmarksOf(sources);
+  const std::unordered_set<std::uint64_t> old_ids(old.ids.begin(), old.ids.end());
+  std::vector<FeatureTrack> test = findMapLandmarks(frame, gray, track_mask, T_W_C, sources);
+  for (const auto& t : tracks_) {
+    if (old_ids.count(t.landmark_id) != 0) test.push_back(t);
+  }
+  if (static_cast<int>(test.size()) < 2 * config_.min_inliers) return false;
+  std::vector<FeatureTrack> saved = std::move(tracks_);
+  tracks_ = std::move(test);
+  Eigen::Isometry3d T = T_W_C;
+  int inliers = 0;
+  const bool posed = estimatePose(frame, T, inliers);
+  tracks_ = std::move(saved);
+  if (!posed || inliers < 2 * config_.min_inliers) return false;
+  constexpr double kMaxStepM = 0.01, kMaxStepRad = 0.5 * M_PI / 180.0;
+  const Eigen::Isometry3d step = T_W_C.inverse() * T;
+  if (step.translation().norm() > kMaxStepM ||
+      Eigen::AngleAxisd(step.linear()).angle() > kMaxStepRad) {
+    return false;
+  }
+  parent = sources.front();
+  return true;
+}
+
+// The keyframe that `newest` pushes out of the bundle-adjustment window is culled if it was
+// found redundant when it was made: tracking had it while it was the newest.
+void Tracker::Impl::cullRedundantKeyframe(std::uint64_t newest) {
+  if (config_.ba_window <= 0) return;
+  const auto window = static_cast<std::uint64_t>(config_.ba_window);
+  if (newest < window) return;
+  const auto it = redundant_into_.find(newest - window);
+  if (it == redundant_into_.end()) return;
+  const std::uint64_t id = it->first, parent = it->second;
+  redundant_into_.erase(it);
+  if (id == ref_kf_ || !map_.cull(id, parent)) return;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++stats_.culled_keyframes;
 }
 
 bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,

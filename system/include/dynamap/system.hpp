@@ -36,7 +36,10 @@ struct TrackOutput {
 struct SystemCounts {
   std::size_t frames = 0;  ///< frames given to track() / mapWithPose() / markBadFrame()
   std::size_t tracked = 0, relocalized = 0, lost = 0, bad_frames = 0;
-  std::size_t keyframes = 0;
+  std::size_t keyframes = 0;  ///< made and kept (not culled)
+  /// Made, then culled as redundant (tracking.kf_cull_redundant): not in keyframes() or a saved
+  /// map; their views stay in the dense map (mapped_keyframes counts them).
+  std::size_t culled_keyframes = 0;
   /// Integrated by the backend so far: a keyframe is, about mapping.window_after_s after its
   /// frame (once judged); all of them after finish(). With mapping.visibility_final_pass the
   /// backend gets them only in finish() (0 before).

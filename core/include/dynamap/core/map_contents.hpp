@@ -31,6 +31,16 @@ struct MapKeyframe {
   /// Its view outside the motion mask on a coarse grid (view_coverage.hpp; not saved: empty,
   /// static everywhere, for a saved map's keyframes).
   cv::Mat static_cells;
+  /// Culled (LocalMap::cull()): older keyframes already held its view. It follows the keyframe
+  /// `parent` rigidly (T_W_C = parent's T_W_C * T_parent_C): its observations constrain the
+  /// parent in bundle adjustment, its landmarks are searched as the parent's, and it is in no
+  /// revisit, relocalization, keyframe list or saved map of its own.
+  bool culled = false;
+  std::uint64_t parent = 0;
+  Eigen::Isometry3d T_parent_C = Eigen::Isometry3d::Identity();
+  /// The keyframes culled into this one: their landmarks are searched as its own (revisits,
+  /// the local search, relocalization), so culling takes no landmark out of reach.
+  std::vector<std::uint64_t> culled_children;
   /// From a saved map (an earlier run): held fixed by bundle adjustment, and older than any
   /// keyframe of this run for revisits whatever its timestamp.
   bool loaded = false;

@@ -38,6 +38,8 @@ struct TrackingResult {
 /// Counters over all frames. frames = tracked + relocalized + lost + bad_frames.
 struct TrackerStats {
   std::size_t frames = 0, tracked = 0, relocalized = 0, lost = 0, keyframes = 0;
+  /// Of `keyframes`, culled later (TrackerConfig::kf_cull_redundant).
+  std::size_t culled_keyframes = 0;
   std::size_t bad_frames = 0;
   std::size_t loops = 0;          ///< loops verified by the loop closer (tracking.loop_closure)
   std::size_t loop_closures = 0;  ///< pose-graph corrections applied
@@ -47,6 +49,7 @@ struct KeyframeInfo {
   std::uint64_t id;
   double timestamp_s;
   Eigen::Isometry3d T_W_C;
+  bool culled = false;  ///< redundant, follows an older keyframe (MapKeyframe::culled)
 };
 
 /// RGB-D tracking front end: ORB features tracked by pyramidal LK, PnP-RANSAC + Ceres motion-only

@@ -105,6 +105,14 @@ struct TrackerConfig {
   /// third of the landmarks in view (teddy x10: 144 keyframes; 3000 at 7: 96).
   int kf_reuse_orb_features = 3000;
   int kf_reuse_orb_fast_threshold = 7;
+  /// A keyframe made where the 8 nearest keyframes older than the bundle-adjustment window saw
+  /// all but kf_reuse_max_uncovered_share of its static view, and their landmarks alone
+  /// (2 x min_inliers inliers) pose the frame within 1 cm / 0.5 deg of its own tracks, is culled
+  /// when it leaves the window: it leaves the keyframe list and a saved map, follows the nearest
+  /// of them rigidly (its frames keep their poses; its observations stay in bundle adjustment
+  /// through that parent, its landmarks are searched as the parent's), and the dense map keeps
+  /// what it held. teddy x10: 96 -> 80 keyframes (one pass: 64), ATE 1.05 cm.
+  bool kf_cull_redundant = true;
 
   // --- local bundle adjustment (own thread) ---
   bool bundle_adjustment = true;  ///< local BA on its own thread

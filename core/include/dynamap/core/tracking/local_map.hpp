@@ -25,6 +25,9 @@ struct BaWindow {
     int landmark;  ///< index into landmark_ids / points
     Eigen::Vector2d px;
     double depth_m;
+    /// -1: seen by keyframe `keyframe` itself; otherwise by a keyframe culled into it, whose
+    /// camera is attached[attached] (T_C_P: from the parent's camera) away from it.
+    int attached = -1;
   };
   std::vector<std::uint64_t> keyframe_ids;
   std::vector<Eigen::Isometry3d> poses;
@@ -32,6 +35,7 @@ struct BaWindow {
   std::vector<std::uint64_t> landmark_ids;
   std::vector<Eigen::Vector3d> points;
   std::vector<Observation> observations;
+  std::vector<Eigen::Isometry3d> attached;
   int generation = 0;   ///< LocalMap::generation() when taken: a stale window is not applied
   bool global = false;  ///< every keyframe of the map (ba_global_every_keyframes)
 };
@@ -44,7 +48,13 @@ class LocalMap {
   std::uint64_t addKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                             std::vector<KeyframeObservation> observations,
                             double masked_share = 0.0, cv::Mat static_cells = cv::Mat());
-  std::size_t keyframeCount() const;
+  std::size_t keyframeCount() const;  ///< culled ones included (ids stay dense)
+  /// Culls keyframe `id` into the older keyframe `parent` (MapKeyframe::culled): it follows
+  /// `parent` rigidly from now on, and the windows of snapshotWindow() hold its observations as
+  /// the parent's (BaWindow::Observation::attached). False (nothing changed) if either is culled,
+  /// `parent` is not older, or `id` is 0 or loaded.
+  bool cull(std::uint64_t id, std::uint64_t parent);
+  bool isCulled(std::uint64_t id) const;
   Eigen::Isometry3d keyframePose(std::uint64_t id) const;
   /// Landmarks observed inside a dynamic region: left out of BA and relocalization from now on.
   void markBad(const std::vector<std::uint64_t>& ids);
@@ -76,16 +86,17 @@ class LocalMap {
                        std::vector<Eigen::Vector3d>& points) const;
   std::vector<KeyframeInfo> keyframes() const;
 
-  /// Keyframes whose pose is within `max_translation_m` and `max_rotation_deg` of T_W_C, made
-  /// at `latest_s` or before, the nearest first (by the larger of the two distances, each over
-  /// its limit).
+  /// Keyframes not culled whose pose is within `max_translation_m` and `max_rotation_deg` of
+  /// T_W_C, made at `latest_s` or before, the nearest first (by the larger of the two distances,
+  /// each over its limit).
   std::vector<std::uint64_t> keyframesNear(const Eigen::Isometry3d& T_W_C, double max_translation_m,
                                            double max_rotation_deg,
                                            double latest_s = INFINITY) const;
   /// The good landmarks those keyframes observed, each once, in the keyframes' order.
   LandmarkCandidates landmarksOf(const std::vector<std::uint64_t>& keyframe_ids) const;
   std::size_t observationCount(std::uint64_t keyframe_id) const;
-  /// A copy of everything (a saved map's tracker part).
+  /// A copy of everything but the culled keyframes, renumbered densely (a saved map's tracker
+  /// part).
   MapContents contents() const;
   /// Replaces the contents with a saved map's, its keyframes marked loaded (fixed in bundle
   /// adjustment, old enough for any revisit). Ids must be dense (MapContents).
@@ -95,10 +106,13 @@ class LocalMap {
 
  private:
   LandmarkCandidates landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const;
+  /// Culled keyframes back on their parents' poses; appends an update for each that moved.
+  void followParentsLocked(std::vector<PoseUpdate>& updates);
 
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
   std::vector<MapKeyframe> keyframes_;
+  std::vector<std::uint64_t> culled_;  ///< culled keyframes, in culling order
   int generation_ = 0;
 };
 

@@ -45,6 +45,30 @@ struct RgbdResidual {
   double fx, fy, cx, cy, u, v, z, w_px, w_z;
 };
 
+/// The same residual for a camera rigidly attached to the pose block's: a culled keyframe's
+/// observation (LocalMap::cull()) constrains its parent's pose. T_C_P = the culled keyframe's
+/// camera from its parent's.
+struct RgbdAttachedResidual {
+  RgbdAttachedResidual(const RgbdResidual& base, const Eigen::Isometry3d& T_C_P)
+      : r(base), R(T_C_P.rotation()), t(T_C_P.translation()) {}
+  template <typename T>
+  bool operator()(const T* pose, const T* point, T* out) const {
+    // T_C_W = T_C_P * T_P_W: the parent's block composed with the fixed offset.
+    T p_P[3];
+    ceres::AngleAxisRotatePoint(pose, point, p_P);
+    for (int i = 0; i < 3; ++i) p_P[i] += pose[3 + i];
+    T p_C[3];
+    for (int i = 0; i < 3; ++i) {
+      p_C[i] = T(R(i, 0)) * p_P[0] + T(R(i, 1)) * p_P[1] + T(R(i, 2)) * p_P[2] + T(t[i]);
+    }
+    const T identity[6] = {T(0), T(0), T(0), T(0), T(0), T(0)};
+    return r(identity, p_C, out);
+  }
+  RgbdResidual r;
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+};
+
 /// The same residual with a fixed point (motion-only refinement).
 struct RgbdPoseOnlyResidual {
   RgbdPoseOnlyResidual(const RgbdResidual& base, const Eigen::Vector3d& p_W) : r(base), p(p_W) {}

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <mutex>
+#include <unordered_map>
 #include <vector>
 
 #include "dynamap/core/tracker.hpp"
@@ -129,6 +130,18 @@ class Tracker::Impl {
   double uncoveredView(const RgbdFrame& frame, const cv::Mat& movers,
                        const Eigen::Isometry3d& T_W_C,
                        const std::vector<std::uint64_t>& near) const;
+  /// Whether a keyframe made now would be redundant (tracking.kf_cull_redundant): the nearest
+  /// 8 keyframes older than the bundle-adjustment window cover its static view but
+  /// kf_reuse_max_uncovered_share, and their landmarks alone pose the frame within 1 cm / 0.5 deg
+  /// of T_W_C. `parent` = the nearest of them. Changes nothing.
+  bool coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Mat& gray,
+                               const cv::Mat& track_mask, const cv::Mat& movers,
+                               const Eigen::Isometry3d& T_W_C, std::uint64_t& parent);
+  /// The keyframe that `newest` pushes out of the bundle-adjustment window is culled into its
+  /// parent if coveredByOlderKeyframes() found it redundant when it was made.
+  void cullRedundantKeyframe(std::uint64_t newest);
+  /// Every keyframe within the keyframe limits of T_W_C, the nearest first.
+  std::vector<std::uint64_t> reuseSourcesAll(const Eigen::Isometry3d& T_W_C) const;
   /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
   std::vector<std::uint64_t> localKeyframes(const Eigen::Isometry3d& T_W_C) const;
   std::vector<std::uint64_t> trackedLandmarks() const;
@@ -200,6 +213,9 @@ class Tracker::Impl {
   /// Fewer tracks than this make a keyframe due: min_tracked_features, lower after a revisit
   /// of a keyframe with fewer points (reuseKeyframe()).
   double ref_min_tracks_ = 0.0;
+  /// Keyframes found redundant when made (coveredByOlderKeyframes()) -> their parent, until
+  /// they leave the bundle-adjustment window and are culled.
+  std::unordered_map<std::uint64_t, std::uint64_t> redundant_into_;
 
   /// A loaded map not yet relocalized in: its keyframes' static descriptors, for place
   /// recognition (null otherwise).
