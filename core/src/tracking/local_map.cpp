@@ -55,13 +55,13 @@ bool LocalMap::isCulled(std::uint64_t id) const {
   return keyframes_.at(id).culled;
 }
 
-void LocalMap::followParentsLocked(std::vector<PoseUpdate>& updates) {
+void LocalMap::followParentsLocked(std::vector<PoseUpdate>* updates) {
   for (const auto id : culled_) {
     MapKeyframe& kf = keyframes_[id];
     const Eigen::Isometry3d T_W_C = keyframes_[kf.parent].T_W_C * kf.T_parent_C;
     if (T_W_C.isApprox(kf.T_W_C, 1e-12)) continue;
     kf.T_W_C = T_W_C;
-    updates.push_back(PoseUpdate{id, T_W_C});
+    if (updates != nullptr) updates->push_back(PoseUpdate{id, T_W_C});
   }
 }
 
@@ -171,7 +171,7 @@ std::vector<PoseUpdate> LocalMap::apply(const BaWindow& solved) {
   for (std::size_t i = 0; i < solved.landmark_ids.size(); ++i) {
     landmarks_[solved.landmark_ids[i]].p_W = solved.points[i];
   }
-  followParentsLocked(updates);
+  followParentsLocked(&updates);
   return updates;
 }
 
@@ -200,8 +200,7 @@ std::vector<PoseUpdate> LocalMap::applyLoopCorrection(const LoopCorrection& corr
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     keyframes_[k].T_W_C = move_of[k] * keyframes_[k].T_W_C;
   }
-  std::vector<PoseUpdate> ignored;  // every keyframe is listed below anyway
-  followParentsLocked(ignored);
+  followParentsLocked(nullptr);  // every keyframe is listed below anyway
   for (const auto& kf : keyframes_) updates.push_back(PoseUpdate{kf.id, kf.T_W_C});
   generation_ = correction.generation;
   return updates;

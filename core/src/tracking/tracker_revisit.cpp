@@ -3,7 +3,6 @@
 // of new landmarks beside the old ones. Keyframes grow with the space explored, not with time.
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <unordered_set>
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
@@ -16,13 +15,13 @@ namespace {
 /// The landmarks of this many of the nearest keyframes are matched to the frame.
 constexpr std::size_t kReuseSourceKeyframes = 8;
 
-/// The pose with the old landmarks may correct drift, not jump: farther than this from the
-/// pose of the frame's own tracks, the matches are wrong.
-bool smallStep(const Eigen::Isometry3d& T_W_C, const Eigen::Isometry3d& T_W_C_reused) {
-  constexpr double kMaxStepM = 0.05, kMaxStepRad = 3.0 * M_PI / 180.0;
-  const Eigen::Isometry3d step = T_W_C.inverse() * T_W_C_reused;
-  return step.translation().norm() <= kMaxStepM &&
-         Eigen::AngleAxisd(step.linear()).angle() <= kMaxStepRad;
+/// Whether the pose with the old landmarks lies within max_m / max_deg of the pose of the
+/// frame's own tracks.
+bool smallStep(const Eigen::Isometry3d& T_W_C, const Eigen::Isometry3d& T_W_C_old, double max_m,
+               double max_deg) {
+  const Eigen::Isometry3d step = T_W_C.inverse() * T_W_C_old;
+  return step.translation().norm() <= max_m &&
+         Eigen::AngleAxisd(step.linear()).angle() <= max_deg * M_PI / 180.0;
 }
 
 }  // namespace
@@ -108,8 +107,7 @@ std::vector<std::uint64_t> Tracker::Impl::reuseSourcesAll(const Eigen::Isometry3
 }
 
 std::vector<std::uint64_t> Tracker::Impl::reuseSources(const Eigen::Isometry3d& T_W_C) const {
-  std::vector<std::uint64_t> near =
-      map_.keyframesNear(T_W_C, config_.kf_max_translation_m, config_.kf_max_rotation_deg);
+  std::vector<std::uint64_t> near = reuseSourcesAll(T_W_C);
   near.resize(std::min(near.size(), kReuseSourceKeyframes));
   return near;
 }
@@ -163,13 +161,8 @@ bool Tracker::Impl::coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Ma
   int inliers = 0;
   const bool posed = estimatePose(frame, T, inliers);
   tracks_ = std::move(saved);
-  if (!posed || inliers < 2 * config_.min_inliers) return false;
-  constexpr double kMaxStepM = 0.01, kMaxStepRad = 0.5 * M_PI / 180.0;
-  const Eigen::Isometry3d step = T_W_C.inverse() * T;
-  if (step.translation().norm() > kMaxStepM ||
-      Eigen::AngleAxisd(step.linear()).angle() > kMaxStepRad) {
-    return false;
-  }
+  // No drift between the frame and the old map to lock in when it follows its parent.
+  if (!posed || inliers < 2 * config_.min_inliers || !smallStep(T_W_C, T, 0.01, 0.5)) return false;
   parent = sources.front();
   return true;
 }
@@ -214,7 +207,9 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
   Eigen::Isometry3d T = T_W_C;
   int n = 0;
   if (static_cast<double>(tracks_.size()) < needed || !estimatePose(frame, T, n) ||
-      static_cast<int>(tracks_.size()) < 2 * config_.min_inliers || !smallStep(T_W_C, T)) {
+      static_cast<int>(tracks_.size()) < 2 * config_.min_inliers ||
+      // The old landmarks may correct drift, not jump: farther, the matches are wrong.
+      !smallStep(T_W_C, T, 0.05, 3.0)) {
     tracks_ = saved;
     return false;
   }

@@ -106,8 +106,9 @@ class LocalMap {
 
  private:
   LandmarkCandidates landmarksOfLocked(const std::vector<std::uint64_t>& keyframe_ids) const;
-  /// Culled keyframes back on their parents' poses; appends an update for each that moved.
-  void followParentsLocked(std::vector<PoseUpdate>& updates);
+  /// Culled keyframes back on their parents' poses; appends an update for each that moved to
+  /// `updates` (may be null).
+  void followParentsLocked(std::vector<PoseUpdate>* updates);
 
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
