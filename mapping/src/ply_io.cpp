@@ -273,53 +273,6 @@ PlyData readPly(const std::string& path, bool with_faces) {
   return data;
 }
 
-void writePly(const std::string& path, const PlyData& data) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw MappingError(path + ": cannot write PLY file");
-  const bool colours = !data.colors.empty() && data.colors.size() == data.vertices.size();
-  out << "ply\nformat binary_little_endian 1.0\ncomment dynamap\n"
-      << "element vertex " << data.vertices.size() << "\n"
-      << "property float x\nproperty float y\nproperty float z\n";
-  if (colours) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-  if (!data.triangles.empty()) {
-    out << "element face " << data.triangles.size() << "\n"
-        << "property list uchar int vertex_indices\n";
-  }
-  out << "end_header\n";
-  // Records are packed into one buffer and written in large blocks (a write per vertex cost more
-  // than the bytes).
-  const std::size_t vertex_bytes = 3 * sizeof(float) + (colours ? 3 : 0);
-  constexpr std::size_t kFaceBytes = 1 + 3 * sizeof(std::int32_t);
-  constexpr std::size_t kBlockRecords = 1 << 16;
-  std::vector<char> block;
-  const auto put = [&block](const void* bytes, std::size_t n) {
-    const auto* c = static_cast<const char*>(bytes);
-    block.insert(block.end(), c, c + n);
-  };
-  const auto flush = [&] {
-    out.write(block.data(), static_cast<std::streamsize>(block.size()));
-    block.clear();
-  };
-  block.reserve(kBlockRecords * std::max(vertex_bytes, kFaceBytes));
-  for (std::size_t i = 0; i < data.vertices.size(); ++i) {
-    put(data.vertices[i].data(), 3 * sizeof(float));
-    if (colours) put(data.colors[i].data(), 3);
-    if ((i + 1) % kBlockRecords == 0) flush();
-  }
-  flush();
-  for (std::size_t i = 0; i < data.triangles.size(); ++i) {
-    const auto& t = data.triangles[i];
-    const std::uint8_t n = 3;
-    put(&n, 1);
-    const std::int32_t idx[3] = {static_cast<std::int32_t>(t[0]), static_cast<std::int32_t>(t[1]),
-                                 static_cast<std::int32_t>(t[2])};
-    put(idx, sizeof(idx));
-    if ((i + 1) % kBlockRecords == 0) flush();
-  }
-  flush();
-  if (!out) throw MappingError(path + ": write failed");
-}
-
 void writeAtomically(const std::string& final_path,
                      const std::function<void(const std::string& tmp_path)>& write) {
   namespace fs = std::filesystem;

@@ -22,6 +22,7 @@ struct PlyData {
 PlyData readPly(const std::string& path, bool with_faces = false);
 
 /// Binary little-endian PLY: x y z float32, red green blue uchar (if colours), faces (if any).
+/// (PlyWriter in ply_writer.hpp writes the same file piece by piece.)
 void writePly(const std::string& path, const PlyData& data);
 
 /// Writes through `write(tmp_path)` to a temporary name in the same folder, then renames it to
