@@ -29,6 +29,8 @@ class PluginBackend final : public MapBackend {
   bool fusesViews() const override { return inner_->fusesViews(); }
   bool needsPoints() const override { return inner_->needsPoints(); }
   bool importMap(const std::string& dir) override { return inner_->importMap(dir); }
+  bool canDeintegrate() const override { return inner_->canDeintegrate(); }
+  void deintegrate(const KeyframeView& view) override { inner_->deintegrate(view); }
 
  private:
   std::shared_ptr<void> handle_;

@@ -289,27 +289,37 @@ std::unordered_map<std::uint64_t, cv::Mat> MappingWorker::revisedMasks() const {
   return revised_masks_;
 }
 
+void MappingWorker::recordPointsLocked(std::uint64_t id, StaticPoints& sp) const {
+  const KeyframeRecord& rec = records_.at(id);
+  rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
+  if (backend_->needsPoints()) {
+    backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                     &sp.colors);
+  }
+}
+
 void MappingWorker::rebuildIfNeeded(bool force) {
   if (!force && backend_->poseUpdateMode() != PoseUpdateMode::kReintegrate) return;
-  bool moved = force;
-  for (const auto& kv : records_) {
-    moved = moved || movedBeyond(kv.second.T_integrated, kv.second.T_current,
-                                 kReintegrateTranslationM, kReintegrateRotationRad);
+  std::vector<std::uint64_t> moved;
+  for (const std::uint64_t id : order_) {
+    const KeyframeRecord& rec = records_.at(id);
+    if (movedBeyond(rec.T_integrated, rec.T_current, kReintegrateTranslationM,
+                    kReintegrateRotationRad)) {
+      moved.push_back(id);
+    }
   }
-  if (!moved) return;
+  if (!force && moved.empty()) return;
+  // Taking a keyframe out and in again costs two integrations: cheaper than all of them while
+  // fewer than half moved.
+  if (!force && backend_->canDeintegrate() && 2 * moved.size() < order_.size()) {
+    moveKeyframesLocked(moved);
+    return;
+  }
   ScopedStageTimer timer(timings_, "mapping_rebuild");
   if (!deferred()) backend_->reset();  // deferred: the backend has had nothing yet
   supplements_ = 0;                    // a record's depth holds its supplement
   // Keyframes are integrated in their order on this thread while the next one's points are made
   // on the other (it reads only its own record).
-  const auto prepare = [this](std::uint64_t id, StaticPoints& sp) {
-    const KeyframeRecord& rec = records_.at(id);
-    rec.depth_u16.convertTo(sp.static_depth_m, CV_32FC1, 1.0 / kDepthUnitsPerM);
-    if (backend_->needsPoints()) {
-      backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                       &sp.colors);
-    }
-  };
   const auto integrate = [this](std::uint64_t id, const StaticPoints& sp) {
     KeyframeRecord& rec = records_.at(id);
     std::optional<ScopedStageTimer> timer;  // deferred: the backend's cost per keyframe
@@ -319,17 +329,35 @@ void MappingWorker::rebuildIfNeeded(bool force) {
     rec.integrated = true;
   };
   StaticPoints sp[2];
-  if (!order_.empty()) prepare(order_.front(), sp[0]);
+  if (!order_.empty()) recordPointsLocked(order_.front(), sp[0]);
   for (std::size_t i = 0; i < order_.size(); ++i) {
     inTwo([&](int h) {
       if (h == 1) {
         integrate(order_[i], sp[i % 2]);
       } else if (i + 1 < order_.size()) {
-        prepare(order_[i + 1], sp[(i + 1) % 2]);
+        recordPointsLocked(order_[i + 1], sp[(i + 1) % 2]);
       }
     });
   }
   reintegrated_ = order_.size();
+}
+
+// A keyframe with a supplement (held pixels confirmed later) went in as two views and comes out
+// as one (its depth holds both): the cells both saw keep a little of the first.
+void MappingWorker::moveKeyframesLocked(const std::vector<std::uint64_t>& ids) {
+  ScopedStageTimer timer(timings_, "mapping_move");
+  for (const std::uint64_t id : ids) {
+    KeyframeRecord& rec = records_.at(id);
+    if (!rec.integrated) continue;  // it goes in with its current pose
+    ScopedStageTimer one(timings_, "mapping_move_keyframe");
+    StaticPoints sp;
+    recordPointsLocked(id, sp);
+    backend_->deintegrate(
+        keyframeView(id, rec.timestamp_s, rec.T_integrated, camera_, rec.bgr, sp));
+    backend_->integrate(keyframeView(id, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
+    rec.T_integrated = rec.T_current;
+    ++reintegrated_;
+  }
 }
 
 void MappingWorker::drain() {

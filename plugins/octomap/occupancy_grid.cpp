@@ -34,6 +34,7 @@ void writeOccupancyGrid(const octomap::OcTree& tree, const GridOptions& options,
   std::vector<unsigned char> cells(static_cast<std::size_t>(width) * height, kUnknown);
   const unsigned max_depth = tree.getTreeDepth();
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (std::fabs(it->getLogOdds()) < kUnknownLogOdds) continue;
     const bool occupied = tree.isNodeOccupied(*it);
     const double size = it.getSize();
     const int n = 1 << (max_depth - it.getDepth());  // finest cells per side

@@ -8,6 +8,10 @@ namespace dynamap::plugin {
 
 /// Which world axis is "up" (0 = x, 1 = y, 2 = z; sign -1 for -x/-y/-z) and the height band
 /// whose cells are projected into the 2D grid.
+/// |log-odds| below this: a cell no view sees any more (one taken out by deintegrate(), which
+/// cannot always delete it); the grid leaves it unknown. (A hit is 0.85, a miss 0.41.)
+inline constexpr float kUnknownLogOdds = 1e-3f;
+
 struct GridOptions {
   int up_axis = 2;
   int up_sign = 1;

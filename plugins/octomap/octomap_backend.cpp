@@ -5,6 +5,7 @@
 // in the tree, in keyframe order (the same updates as insertPointCloud, the same map).
 // Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres). A saved
 // map's map.ot (importMap()) is the tree's start, to which each rebuild's reset() returns.
+#include <cmath>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -45,36 +46,15 @@ class OctomapBackend final : public MapBackend {
   }
 
   void integrate(const KeyframeView& view) override {
-    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
-    const Eigen::Vector3d o = view.T_W_C.translation();
-    octomap::Pointcloud cloud;
-    cloud.reserve(view.points_C->size());
-    if (discretize_) {
-      octomap::KeySet seen;
-      for (const auto& p_C : *view.points_C) {
-        const Eigen::Vector3f p = T * p_C;
-        octomap::OcTreeKey key;
-        if (!tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
-        if (seen.insert(key).second) cloud.push_back(tree_->keyToCoord(key));
-      }
-    } else {
-      for (const auto& p_C : *view.points_C) {
-        const Eigen::Vector3f p = T * p_C;
-        cloud.push_back(p.x(), p.y(), p.z());
-      }
-    }
-    // The caster is free once the previous keyframe's rays are in; its cells go into the tree
-    // while this keyframe's rays are cast.
-    std::unique_ptr<Cells> previous = pending_.valid() ? pending_.get() : nullptr;
-    pending_ = std::async(std::launch::async, [this, cloud = std::move(cloud),
-                                               origin = octomap::point3d(o.x(), o.y(), o.z())] {
-      auto cells = std::make_unique<Cells>();
-      caster_.computeUpdate(cloud, origin, cells->free, cells->occupied, max_range_m_);
-      return cells;
-    });
-    if (previous) apply(*previous);
-    dirty_inner_ = true;
+    castAndApply(view, +1);
     ++keyframes_;
+  }
+  bool canDeintegrate() const override { return true; }
+  // The same rays again, their log-odds subtracted: exact but where a cell's clamping cut an
+  // update off (a cell at the clamp takes back more than the keyframe had added).
+  void deintegrate(const KeyframeView& view) override {
+    castAndApply(view, -1);
+    if (keyframes_ > 0) --keyframes_;
   }
 
   void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
@@ -128,7 +108,42 @@ class OctomapBackend final : public MapBackend {
  private:
   struct Cells {
     octomap::KeySet free, occupied;
+    int sign = +1;  ///< -1: a keyframe taken out
   };
+  /// The view's points reduced to distinct voxel centres (discretize_), its rays cast on another
+  /// thread, the previous view's cells written into the tree meanwhile, each with `sign`.
+  void castAndApply(const KeyframeView& view, int sign) {
+    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
+    const Eigen::Vector3d o = view.T_W_C.translation();
+    octomap::Pointcloud cloud;
+    cloud.reserve(view.points_C->size());
+    if (discretize_) {
+      octomap::KeySet seen;
+      for (const auto& p_C : *view.points_C) {
+        const Eigen::Vector3f p = T * p_C;
+        octomap::OcTreeKey key;
+        if (!tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
+        if (seen.insert(key).second) cloud.push_back(tree_->keyToCoord(key));
+      }
+    } else {
+      for (const auto& p_C : *view.points_C) {
+        const Eigen::Vector3f p = T * p_C;
+        cloud.push_back(p.x(), p.y(), p.z());
+      }
+    }
+    // The caster is free once the previous keyframe's rays are in; its cells go into the tree
+    // while this keyframe's rays are cast.
+    std::unique_ptr<Cells> previous = pending_.valid() ? pending_.get() : nullptr;
+    pending_ = std::async(std::launch::async, [this, sign, cloud = std::move(cloud),
+                                               origin = octomap::point3d(o.x(), o.y(), o.z())] {
+      auto cells = std::make_unique<Cells>();
+      cells->sign = sign;
+      caster_.computeUpdate(cloud, origin, cells->free, cells->occupied, max_range_m_);
+      return cells;
+    });
+    if (previous) apply(*previous);
+    dirty_inner_ = true;
+  }
   /// This run's sensor model and clamping (a loaded tree keeps its log-odds, not its model).
   void configure(octomap::OcTree& tree) const {
     tree.setProbHit(prob_hit_);
@@ -136,10 +151,41 @@ class OctomapBackend final : public MapBackend {
     tree.setClampingThresMin(clamp_min_);
     tree.setClampingThresMax(clamp_max_);
   }
-  /// insertPointCloud's updates: the free cells, then the occupied ones.
+  /// insertPointCloud's updates: the free cells, then the occupied ones (taken back in the
+  /// opposite order).
   void apply(const Cells& cells) const {
-    for (const auto& key : cells.free) tree_->updateNode(key, false, /*lazy_eval=*/true);
-    for (const auto& key : cells.occupied) tree_->updateNode(key, true, /*lazy_eval=*/true);
+    if (cells.sign > 0) {
+      for (const auto& key : cells.free) tree_->updateNode(key, false, /*lazy_eval=*/true);
+      for (const auto& key : cells.occupied) tree_->updateNode(key, true, /*lazy_eval=*/true);
+      return;
+    }
+    for (const auto& key : cells.occupied) takeBack(key, -tree_->getProbHitLog());
+    for (const auto& key : cells.free) takeBack(key, -tree_->getProbMissLog());
+  }
+  /// A cell back at log-odds 0 is no longer known (OctoMap takes 0 as occupied): it is deleted,
+  /// or, where it is its parent's only child, left free by a hair, which the grid takes as
+  /// unknown (Debian's OctoMap 1.9.7 asserts when deleteNode() empties a parent: the emptied
+  /// child array is never freed).
+  void takeBack(const octomap::OcTreeKey& key, float delta) const {
+    octomap::OcTreeNode* node = tree_->search(key);
+    if (node == nullptr) return;
+    if (std::fabs(node->getLogOdds() + delta) >= plugin::kUnknownLogOdds) {
+      tree_->updateNode(key, delta, /*lazy_eval=*/true);
+      return;
+    }
+    if (hasSibling(key)) {
+      tree_->deleteNode(key);
+    } else {
+      node->setLogOdds(-0.5f * plugin::kUnknownLogOdds);
+    }
+  }
+  bool hasSibling(const octomap::OcTreeKey& key) const {
+    const unsigned depth = tree_->getTreeDepth();
+    const octomap::OcTreeNode* parent = tree_->search(key, depth - 1);
+    if (parent == nullptr) return false;
+    int children = 0;
+    for (unsigned i = 0; i < 8; ++i) children += tree_->nodeChildExists(parent, i) ? 1 : 0;
+    return children > 1;
   }
   void drain() const {
     if (pending_.valid()) apply(*pending_.get());

@@ -29,12 +29,13 @@ struct FakeLog {
   std::vector<std::size_t> points;
   std::map<std::uint64_t, Eigen::Isometry3d> poses;
   int resets = 0;
+  std::vector<std::pair<std::uint64_t, Eigen::Isometry3d>> taken_out;  ///< id, pose it left at
 };
 
 class FakeBackend final : public MapBackend {
  public:
-  FakeBackend(FakeLog* log, PoseUpdateMode mode, bool fuses = false)
-      : log_(log), mode_(mode), fuses_(fuses) {}
+  FakeBackend(FakeLog* log, PoseUpdateMode mode, bool fuses = false, bool deintegrates = false)
+      : log_(log), mode_(mode), fuses_(fuses), deintegrates_(deintegrates) {}
   void integrate(const KeyframeView& view) override {
     std::unique_lock<std::mutex> lock(log_->mutex);
     log_->cv.wait(lock, [&] { return log_->released; });
@@ -51,11 +52,17 @@ class FakeBackend final : public MapBackend {
   void exportMap(const std::string&) override {}
   MapStats stats() const override { return {}; }
   bool fusesViews() const override { return fuses_; }
+  bool canDeintegrate() const override { return deintegrates_; }
+  void deintegrate(const KeyframeView& view) override {
+    std::lock_guard<std::mutex> lock(log_->mutex);
+    log_->taken_out.emplace_back(view.id, view.T_W_C);
+  }
 
  private:
   FakeLog* log_;
   PoseUpdateMode mode_;
   bool fuses_;
+  bool deintegrates_;
 };
 
 KeyframePacketPtr packet(std::uint64_t id) {
@@ -218,6 +225,45 @@ TEST(MappingWorker, RebuildsVolumetricBackendsOnlyWhenPosesMoved) {
       EXPECT_TRUE(log.poses.at(2).isApprox(updates[2].T_W_C));
       EXPECT_EQ(log.points[3], log.points[0]);  // same static points from the stored depth
     }
+  }
+}
+
+// A backend that can take keyframes out gets only the moved ones out (at the pose they went in
+// with) and in again (at their final pose) while fewer than half moved; else the whole rebuild.
+TEST(MappingWorker, MovesOnlyTheMovedKeyframesOfABackendThatCanTakeThemOut) {
+  for (const int moved : {1, 2}) {  // of 4: out and in again / rebuild
+    FakeLog log;
+    log.released = true;
+    MappingWorker worker(
+        std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate, false, true),
+        SyntheticScene::camera(), countingOptions(), 4, nullptr);
+    std::vector<PoseUpdate> updates;
+    std::vector<Eigen::Isometry3d> first;
+    for (std::uint64_t id = 0; id < 4; ++id) {
+      const auto kf = packet(id);
+      worker.push(kf);
+      first.push_back(kf->T_W_C);
+      const double dx = static_cast<int>(id) < moved ? 0.05 : 0.001;
+      updates.push_back({id, Eigen::Translation3d(dx, 0, 0) * kf->T_W_C});
+    }
+    worker.drain();
+    worker.applyPoseUpdates(updates);
+    worker.finish();
+    if (moved == 1) {
+      EXPECT_EQ(log.resets, 0);
+      ASSERT_EQ(log.taken_out.size(), 1u);
+      EXPECT_EQ(log.taken_out[0].first, 0u);
+      EXPECT_TRUE(log.taken_out[0].second.isApprox(first[0]));
+      EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2, 3, 0}));
+      EXPECT_EQ(log.points[4], log.points[0]);  // the same static points, from the stored depth
+      EXPECT_EQ(worker.reintegratedKeyframes(), 1u);
+    } else {
+      EXPECT_EQ(log.resets, 1);
+      EXPECT_TRUE(log.taken_out.empty());
+      EXPECT_EQ(log.integrated.size(), 8u);
+      EXPECT_EQ(worker.reintegratedKeyframes(), 4u);
+    }
+    EXPECT_TRUE(log.poses.at(0).isApprox(updates[0].T_W_C));
   }
 }
 

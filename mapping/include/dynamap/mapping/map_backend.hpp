@@ -85,6 +85,16 @@ class MapBackend {
     (void)dir;
     return false;
   }
+  /// true: deintegrate() takes a keyframe out again, so that the worker moves a kReintegrate
+  /// keyframe whose pose changed by taking it out at its old pose and integrating it at the new
+  /// one, instead of rebuilding the whole map.
+  virtual bool canDeintegrate() const { return false; }
+  /// Undoes integrate(view) for the same view (same points, same pose), up to what the backend's
+  /// own clamping lost (stats().keyframes counts one less). Only where canDeintegrate().
+  virtual void deintegrate(const KeyframeView& view) {
+    (void)view;
+    throw MappingError("this backend cannot take a keyframe out (canDeintegrate() is false)");
+  }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).
@@ -93,8 +103,8 @@ using BackendParams = std::map<std::string, std::string>;
 /// The one symbol a plugin exports (see plugin_api.hpp). Returns a new backend owned by the
 /// caller; throws MappingError for a bad parameter.
 using BackendFactoryFn = MapBackend* (*)(const BackendParams& params);
-/// v2: MapBackend::needsPoints(); v3: MapBackend::importMap() (a plugin built for an older
-/// version has a shorter vtable: refused by name).
-inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v3";
+/// v2: MapBackend::needsPoints(); v3: MapBackend::importMap(); v4: canDeintegrate() and
+/// deintegrate() (a plugin built for an older version has a shorter vtable: refused by name).
+inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v4";
 
 }  // namespace dynamap

@@ -28,13 +28,14 @@ namespace dynamap {
 /// pixels are revised (heldConfirmedElsewhere()) and what the keyframes within window_before_s
 /// before and window_after_s after it saw through or voted out is removed (removeSeenThrough()),
 /// all with the current poses, and it goes to the backend. Pose updates go to the backend as they
-/// come (kInPlace); volumetric backends (kReintegrate) are rebuilt in finish() when some keyframe
-/// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad` (for that the worker
-/// keeps their keyframes' static depth, 16-bit, and colour; a kInPlace backend's are released
-/// once integrated, the views once out of the window). With options.visibility_final_pass (the
-/// offline extra) the keyframes go to the backend only in finish(), after the held revision and
-/// the visibility pass over all of them with the final poses. All public methods are thread-safe;
-/// exportMap() and stats() see the map as it is (final after finish()).
+/// come (kInPlace); volumetric backends (kReintegrate) follow them in finish() where a keyframe
+/// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad`: a backend that can
+/// take keyframes out has those moved out and in again, else the map is rebuilt (for that the
+/// worker keeps their keyframes' static depth, 16-bit, and colour; a kInPlace backend's are
+/// released once integrated, the views once out of the window). With options.visibility_final_pass
+/// (the offline extra) the keyframes go to the backend only in finish(), after the held revision
+/// and the visibility pass over all of them with the final poses. All public methods are
+/// thread-safe; exportMap() and stats() see the map as it is (final after finish()).
 class MappingWorker {
  public:
   static constexpr double kReintegrateTranslationM = 0.01;
@@ -71,7 +72,8 @@ class MappingWorker {
   void exportMap(const std::string& dir);
   MapStats stats() const;
   std::size_t droppedKeyframes() const { return dropped_.load(); }
-  /// Keyframes re-integrated by the final rebuild (0 if none was needed).
+  /// Keyframes re-integrated to follow their final poses: every one by a rebuild, or those
+  /// moved out and in again (0 if none was needed).
   std::size_t reintegratedKeyframes() const;
   /// The visibility votes so far (online: summed over the windows; final pass: after finish()).
   VisibilityResult visibilityResult() const;
@@ -139,8 +141,14 @@ class MappingWorker {
   /// The kept views of earlier visits near `T_W_C` (options.window_revisit_keyframes), in time
   /// order.
   std::vector<std::uint64_t> revisitContextLocked(const Eigen::Isometry3d& T_W_C) const;
-  /// Rebuilds when a volumetric backend's keyframe moved, or always when `force`.
+  /// Brings a volumetric backend's keyframes that moved to their current poses: each taken out
+  /// and in again while fewer than half moved and the backend can (MapBackend::deintegrate()),
+  /// else the whole map rebuilt; the whole map always when `force`.
   void rebuildIfNeeded(bool force);
+  /// Takes each keyframe out at the pose it went in with and integrates it at its current one.
+  void moveKeyframesLocked(const std::vector<std::uint64_t>& ids);
+  /// The static depth (metres) and, if the backend needs them, points of keyframe `id`'s record.
+  void recordPointsLocked(std::uint64_t id, StaticPoints& sp) const;
   /// The visibility pass over all keyframes; true if it removed pixels.
   bool removeSeenThroughLocked();
   /// Unmasks held-back pixels that another keyframe confirmed static; true if any.
@@ -161,7 +169,8 @@ class MappingWorker {
   int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
-  mutable std::mutex mutex_;  ///< guards queue_, pending_updates_, pushed_, taken_, stopping_, busy_
+  mutable std::mutex
+      mutex_;  ///< guards queue_, pending_updates_, pushed_, taken_, stopping_, busy_
   std::condition_variable not_empty_;
   std::condition_variable not_full_;
   std::condition_variable idle_;
