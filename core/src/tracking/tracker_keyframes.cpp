@@ -289,6 +289,7 @@ void Tracker::Impl::finish() {
                            : all;
     ba_.runOnce(window, config_.final_ba_max_iterations);
   }
+  cullRemainingRedundantKeyframes();  // after the final BA: it keeps their final poses
 }
 
 std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory() const {

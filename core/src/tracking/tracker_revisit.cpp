@@ -182,6 +182,23 @@ void Tracker::Impl::cullRedundantKeyframe(std::uint64_t newest) {
   ++stats_.culled_keyframes;
 }
 
+// At the end of the run the keyframes found redundant that are still in the window go too: no
+// newer keyframe will push them out (a run that revisits a loaded map makes few). After the
+// final bundle adjustment, which solves them free, so every pose stays what it was: culled
+// before it, tied to their parents with offsets the window had not settled yet, Bonn x10's
+// ATE went 2.46 -> 3.65 cm.
+void Tracker::Impl::cullRemainingRedundantKeyframes() {
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> pending(redundant_into_.begin(),
+                                                               redundant_into_.end());
+  std::sort(pending.begin(), pending.end());
+  redundant_into_.clear();
+  for (const auto& [id, parent] : pending) {
+    if (!map_.cull(id, parent)) continue;
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.culled_keyframes;
+  }
+}
+
 bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                   const cv::Mat& track_mask, const cv::Mat& movers,
                                   Eigen::Isometry3d& T_W_C, int& inliers) {

@@ -140,6 +140,8 @@ class Tracker::Impl {
   /// The keyframe that `newest` pushes out of the bundle-adjustment window is culled into its
   /// parent if coveredByOlderKeyframes() found it redundant when it was made.
   void cullRedundantKeyframe(std::uint64_t newest);
+  /// At finish(): culls the keyframes found redundant that are still in the BA window.
+  void cullRemainingRedundantKeyframes();
   /// Every keyframe within the keyframe limits of T_W_C, the nearest first.
   std::vector<std::uint64_t> reuseSourcesAll(const Eigen::Isometry3d& T_W_C) const;
   /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
