@@ -18,6 +18,7 @@
 #include "dynamap/mapping/ply_io.hpp"
 #include "occupancy_grid.hpp"
 #include "octree_file.hpp"
+#include "ray_cells.hpp"
 
 namespace dynamap {
 namespace {
@@ -106,8 +107,7 @@ class OctomapBackend final : public MapBackend {
   }
 
  private:
-  struct Cells {
-    octomap::KeySet free, occupied;
+  struct Cells : plugin::RayCells {
     int sign = +1;  ///< -1: a keyframe taken out
   };
   /// The view's points reduced to distinct voxel centres (discretize_), its rays cast on another
@@ -137,8 +137,9 @@ class OctomapBackend final : public MapBackend {
     pending_ = std::async(std::launch::async, [this, sign, cloud = std::move(cloud),
                                                origin = octomap::point3d(o.x(), o.y(), o.z())] {
       auto cells = std::make_unique<Cells>();
+      static_cast<plugin::RayCells&>(*cells) =
+          plugin::castRays(caster_, cloud, origin, max_range_m_);
       cells->sign = sign;
-      caster_.computeUpdate(cloud, origin, cells->free, cells->occupied, max_range_m_);
       return cells;
     });
     if (previous) apply(*previous);
@@ -217,7 +218,7 @@ class OctomapBackend final : public MapBackend {
   // The last keyframe's cells are applied when the map is next read, by const readers too.
   std::unique_ptr<octomap::OcTree> tree_;
   std::unique_ptr<const octomap::OcTree> loaded_;  ///< importMap()'s tree, of no keyframe
-  octomap::OcTree caster_;  ///< casts rays only (its own key ray buffers), never holds a map
+  octomap::OcTree caster_;  ///< the key grid and ray traversal of the casting thread; no map
   mutable std::future<std::unique_ptr<Cells>> pending_;
   double resolution_m_ = kDefaultResolutionM;
   double prob_hit_ = 0.7, prob_miss_ = 0.4, clamp_min_ = 0.12, clamp_max_ = 0.97;

@@ -1,0 +1,46 @@
+#include "ray_cells.hpp"
+
+#include <cstdint>
+
+#include "dynamap/mapping/flat_index.hpp"
+
+namespace dynamap::plugin {
+namespace {
+
+std::uint64_t packed(const octomap::OcTreeKey& k) {
+  return std::uint64_t{k[0]} | std::uint64_t{k[1]} << 16 | std::uint64_t{k[2]} << 32;
+}
+
+/// Appends `key` to `out` unless `seen` has it.
+void addOnce(const octomap::OcTreeKey& key, FlatIndex& seen, std::vector<octomap::OcTreeKey>& out) {
+  if (seen.tryEmplace(packed(key), 0).second) out.push_back(key);
+}
+
+}  // namespace
+
+RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
+                  const octomap::point3d& origin, double max_range_m) {
+  RayCells cells;
+  FlatIndex free_seen(8 * scan.size()), occupied_seen(scan.size());
+  octomap::KeyRay ray;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const octomap::point3d& p = scan[i];
+    const bool in_range = max_range_m < 0.0 || (p - origin).norm() <= max_range_m;
+    const octomap::point3d end =
+        in_range ? p : origin + (p - origin).normalized() * static_cast<float>(max_range_m);
+    if (tree.computeRayKeys(origin, end, ray)) {
+      for (const octomap::OcTreeKey& key : ray) addOnce(key, free_seen, cells.free);
+    }
+    octomap::OcTreeKey key;
+    if (in_range && tree.coordToKeyChecked(p, key)) addOnce(key, occupied_seen, cells.occupied);
+  }
+  // Occupied wins over free.
+  std::size_t kept = 0;
+  for (const octomap::OcTreeKey& key : cells.free) {
+    if (occupied_seen.find(packed(key)) == FlatIndex::kMissing) cells.free[kept++] = key;
+  }
+  cells.free.resize(kept);
+  return cells;
+}
+
+}  // namespace dynamap::plugin

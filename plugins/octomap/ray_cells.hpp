@@ -1,0 +1,23 @@
+#pragma once
+
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+namespace dynamap::plugin {
+
+/// The cells one scan updates, as OctoMap's OccupancyOcTreeBase::computeUpdate() finds them:
+/// free, the cells its rays cross (cut at `max_range_m` when that is >= 0); occupied, the end
+/// points' within that range; a cell in both is occupied only. Each cell once, in the order
+/// first met (deterministic). The sets are flat hash tables, not OctoMap's node-based
+/// unordered_set of keys, whose allocations, rehashing and freeing took a third of a keyframe's
+/// integration.
+struct RayCells {
+  std::vector<octomap::OcTreeKey> free, occupied;
+};
+
+/// `tree` gives the key grid and the ray traversal (OcTree::computeRayKeys()); only read.
+RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
+                  const octomap::point3d& origin, double max_range_m);
+
+}  // namespace dynamap::plugin
