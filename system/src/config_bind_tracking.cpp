@@ -53,6 +53,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.kf_reuse_orb_features", &c.kf_reuse_orb_features, 1, 100000);
   schema.addInt("tracking.kf_reuse_orb_fast_threshold", &c.kf_reuse_orb_fast_threshold, 1, 255);
   schema.addBool("tracking.kf_cull_redundant", &c.kf_cull_redundant);
+  schema.addBool("tracking.kf_cull_online", &c.kf_cull_online);
 
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);

@@ -170,7 +170,7 @@ bool Tracker::Impl::coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Ma
 // The keyframe that `newest` pushes out of the bundle-adjustment window is culled if it was
 // found redundant when it was made: tracking had it while it was the newest.
 void Tracker::Impl::cullRedundantKeyframe(std::uint64_t newest) {
-  if (config_.ba_window <= 0) return;
+  if (!config_.kf_cull_online || config_.ba_window <= 0) return;  // all at finish()
   const auto window = static_cast<std::uint64_t>(config_.ba_window);
   if (newest < window) return;
   const auto it = redundant_into_.find(newest - window);
@@ -182,11 +182,11 @@ void Tracker::Impl::cullRedundantKeyframe(std::uint64_t newest) {
   ++stats_.culled_keyframes;
 }
 
-// At the end of the run the keyframes found redundant that are still in the window go too: no
-// newer keyframe will push them out (a run that revisits a loaded map makes few). After the
-// final bundle adjustment, which solves them free, so every pose stays what it was: culled
-// before it, tied to their parents with offsets the window had not settled yet, Bonn x10's
-// ATE went 2.46 -> 3.65 cm.
+// At the end of the run the keyframes found redundant go (all of them unless kf_cull_online,
+// else those still in the window: no newer keyframe pushes them out). After the final bundle
+// adjustment, which solves them free, so every pose stays what it was: culled before it, tied
+// to their parents with offsets the window had not settled yet, Bonn x10's ATE went 2.46 ->
+// 3.65 cm.
 void Tracker::Impl::cullRemainingRedundantKeyframes() {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> pending(redundant_into_.begin(),
                                                                redundant_into_.end());
