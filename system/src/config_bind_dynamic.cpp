@@ -36,6 +36,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addBool("dynamic.detector_async", &c.detector_async);
   schema.addBool("dynamic.detector_lockstep", &c.detector_lockstep);
   schema.addInt("dynamic.detector_max_age_frames", &c.detector_max_age_frames, 0, 1000);
+  schema.addInt("dynamic.detector_every_frames", &c.detector_every_frames, 1, 1000);
   schema.addDouble("dynamic.stale_box_growth_px", &c.stale_box_growth_px, 0.0, 100.0);
 
   schema.addStringList("dynamic.high_dynamic_classes", &c.high_dynamic_classes);

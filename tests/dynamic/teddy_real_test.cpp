@@ -93,3 +93,37 @@ TEST(DynamicMotionFilter, DestroyedWhileItsDetectorRuns) {
 
 }  // namespace
 }  // namespace dynamap
+
+namespace dynamap {
+namespace {
+
+// dynamic.detector_every_frames: in a lockstep run only every Nth frame goes to the detector
+// (the first always); the frames between still get the newest detections, moved and grown.
+TEST(DynamicMotionFilter, DetectsEveryNthFrameAndMasksTheOthersFromTheNewest) {
+  DYNAMAP_REQUIRE_SHARED_DATA();
+  DynamicConfig c;
+  c.detector_every_frames = 3;
+  resolveDynamicModelPaths(c, (test::sourceDir() / "config/default.yaml").string());
+  const dynbench::DynSequence seq(test::sharedData() / "dynamic/teddy_dyn_dev");
+  TimingRecorder timing;
+  int masked_frames = 0;
+  {
+    DynamicMotionFilter filter(c, PinholeCamera{}, &timing);
+    dynbench::SequenceFrame prev = seq.load(20);
+    for (int i = 21; i <= 29; ++i) {  // 9 frames: numbers 0-8, detected 0, 3, 6
+      dynbench::SequenceFrame cur = seq.load(i);
+      filter.beginFrame(cur.frame);
+      const FeatureMatches m = dynbench::trackLk(prev.gray, cur.gray);
+      const MotionFilterOutput out = filter.filter({&cur.frame, &prev.gray, &cur.gray, &m});
+      if (!out.dynamic_mask.empty() && cv::countNonZero(out.dynamic_mask) > 0) ++masked_frames;
+      prev = std::move(cur);
+    }
+  }
+  EXPECT_EQ(timing.stats("detector").count, 3u);
+  // Walkers are in view on every one of these frames: each frame but the first (which has no
+  // motion evidence yet) has a mask, the undetected ones included.
+  EXPECT_GE(masked_frames, 8);
+}
+
+}  // namespace
+}  // namespace dynamap

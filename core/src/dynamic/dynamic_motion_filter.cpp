@@ -141,6 +141,7 @@ void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
   begun_stamp_ = frame.timestamp_s;
   if (!worker_ || frame.bgr.empty()) return;
   if (lockstep()) takeDetections(true);  // the previous frame's, whatever the threads' timing
+  if (lockstep() && !detectedFrame(frame_no_)) return;
   const bool wait = !config_.detector_async || lockstep();
   if (!worker_->submit(frame.bgr, frame_no_, frame.timestamp_s, wait)) {
     record("detector_skipped", 0.0);
@@ -149,8 +150,15 @@ void DynamicMotionFilter::beginFrame(const RgbdFrame& frame) {
 
 void DynamicMotionFilter::prefetch(const RgbdFrame& next) {
   // Only lockstep runs read ahead: there the frame after this one is always begun next.
-  if (!worker_ || !lockstep() || next.bgr.empty()) return;
+  // With detector_every_frames > 1 it would have to know the next frame's number, which the
+  // reader's thread does not: no read-ahead then (the detector still overlaps the tracking of
+  // the frame it was given).
+  if (!worker_ || !lockstep() || next.bgr.empty() || config_.detector_every_frames > 1) return;
   worker_->prefetch(next.bgr, next.timestamp_s);
+}
+
+bool DynamicMotionFilter::detectedFrame(long frame_no) const {
+  return frame_no % std::max(1, config_.detector_every_frames) == 0;
 }
 
 bool DynamicMotionFilter::lockstep() const {

@@ -67,6 +67,10 @@ struct DynamicConfig {
   /// while the detector is busy are skipped (`--realtime` sets false).
   bool detector_lockstep = true;
   int detector_max_age_frames = 6;   ///< older detections are not used (async)
+  /// Lockstep runs: only every Nth frame goes to the detector (the first always); the frames
+  /// between use the newest detections, their boxes moved by the flow inside them and grown
+  /// by stale_box_growth_px per frame of age. 1 = every frame.
+  int detector_every_frames = 1;
   double stale_box_growth_px = 3.0;  ///< per frame of age, on every side (async)
 
   // --- class table --------------------------------------------------------------------------

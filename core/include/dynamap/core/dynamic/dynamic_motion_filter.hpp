@@ -66,6 +66,8 @@ class DynamicMotionFilter : public MotionFilter {
   void record(const std::string& stage, double ms);
   std::vector<Detection> currentDetections(const RgbdFrame* frame, const FeatureMatches& m);
   bool lockstep() const;  ///< detector_async && detector_lockstep
+  /// Lockstep: whether frame `frame_no` goes to the detector (detector_every_frames).
+  bool detectedFrame(long frame_no) const;
   /// Moves the worker's newest finished detections (with `wait`, of the frame in flight) into
   /// latest_, if there are any.
   void takeDetections(bool wait);
