@@ -63,6 +63,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.ba_global_every_keyframes", &c.ba_global_every_keyframes, 0, 1000000);
   schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);
   schema.addInt("tracking.final_ba_max_iterations", &c.final_ba_max_iterations, 1, 500);
+  schema.addBool("tracking.blend_reference_switches", &c.blend_reference_switches);
 
   schema.addInt("tracking.local_search_keyframes", &c.local_search_keyframes, 0, 1000);
   schema.addDouble("tracking.local_search_radius_px", &c.local_search_radius_px, 0.5, 200.0);

@@ -4,6 +4,7 @@
 
 #include "dynamap/core/tracking/depth_sampling.hpp"
 #include "dynamap/core/tracking/landmark_search.hpp"
+#include "dynamap/core/tracking/reference_blend.hpp"
 #include "dynamap/core/tracking/tracker_impl.hpp"
 
 namespace dynamap {
@@ -294,13 +295,27 @@ void Tracker::Impl::finish() {
 
 std::vector<std::pair<double, Eigen::Isometry3d>> Tracker::Impl::finalTrajectory() const {
   const std::vector<KeyframeInfo> kfs = map_.keyframes();
-  std::vector<std::pair<double, Eigen::Isometry3d>> out;
-  out.reserve(records_.size());
+  std::vector<ReferencedFrame> frames;
+  frames.reserve(records_.size());
   for (const auto& r : records_) {
     if (r.unposed) continue;
-    const Eigen::Isometry3d T_W_C = r.has_ref ? kfs.at(r.ref_kf).T_W_C * r.T_ref_C : r.T_W_C;
-    out.emplace_back(r.timestamp_s, T_W_C);
+    ReferencedFrame f;
+    f.timestamp_s = r.timestamp_s;
+    f.has_ref = r.has_ref;
+    f.ref_kf = r.ref_kf;
+    f.T_W_C_tracked = r.T_W_C;
+    if (r.has_ref) f.correction = kfs.at(r.ref_kf).T_W_C * r.T_ref_C * r.T_W_C.inverse();
+    frames.push_back(f);
   }
+  std::vector<Eigen::Isometry3d> poses;
+  if (config_.blend_reference_switches) {
+    poses = blendReferenceSwitches(frames);
+  } else {
+    for (const auto& f : frames) poses.push_back(f.correction * f.T_W_C_tracked);
+  }
+  std::vector<std::pair<double, Eigen::Isometry3d>> out;
+  out.reserve(frames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i) out.emplace_back(frames[i].timestamp_s, poses[i]);
   return out;
 }
 

@@ -144,6 +144,11 @@ struct TrackerConfig {
   /// 5 gave the same ATE (to 0.1 mm; Bonn x10 1.91 -> 1.82 cm) in half the time; 3 lost
   /// accuracy (Bonn x10 2.32 cm).
   int final_ba_max_iterations = 5;
+  /// The trajectory's frames take their reference keyframe's final pose; where the reference
+  /// changes, the jump between the two keyframes' corrections is spread over the frames since
+  /// the previous change (blendReferenceSwitches()), instead of each frame following its
+  /// reference alone.
+  bool blend_reference_switches = true;
 
   // --- search of the local map at keyframes ---
   /// Landmarks of the newest keyframes that are no longer tracked are matched by projection to
