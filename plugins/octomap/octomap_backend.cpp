@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <future>
 #include <memory>
-#include <unordered_set>
 
 #include <octomap/OcTree.h>
 
@@ -116,16 +115,10 @@ class OctomapBackend final : public MapBackend {
     const Eigen::Isometry3f T = view.T_W_C.cast<float>();
     const Eigen::Vector3d o = view.T_W_C.translation();
     octomap::Pointcloud cloud;
-    cloud.reserve(view.points_C->size());
     if (discretize_) {
-      octomap::KeySet seen;
-      for (const auto& p_C : *view.points_C) {
-        const Eigen::Vector3f p = T * p_C;
-        octomap::OcTreeKey key;
-        if (!tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
-        if (seen.insert(key).second) cloud.push_back(tree_->keyToCoord(key));
-      }
+      cloud = plugin::distinctCellCentres(*tree_, *view.points_C, T);
     } else {
+      cloud.reserve(view.points_C->size());
       for (const auto& p_C : *view.points_C) {
         const Eigen::Vector3f p = T * p_C;
         cloud.push_back(p.x(), p.y(), p.z());

@@ -43,4 +43,19 @@ RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
   return cells;
 }
 
+octomap::Pointcloud distinctCellCentres(const octomap::OcTree& tree,
+                                        const std::vector<Eigen::Vector3f>& points_C,
+                                        const Eigen::Isometry3f& T_W_C) {
+  octomap::Pointcloud cloud;
+  cloud.reserve(points_C.size());
+  FlatIndex seen(points_C.size() / 4 + 16);  // grows if needed
+  for (const auto& p_C : points_C) {
+    const Eigen::Vector3f p = T_W_C * p_C;
+    octomap::OcTreeKey key;
+    if (!tree.coordToKeyChecked(p.x(), p.y(), p.z(), key)) continue;
+    if (seen.tryEmplace(packed(key), 0).second) cloud.push_back(tree.keyToCoord(key));
+  }
+  return cloud;
+}
+
 }  // namespace dynamap::plugin

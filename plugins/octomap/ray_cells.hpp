@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <octomap/OcTree.h>
 
 namespace dynamap::plugin {
@@ -19,5 +20,12 @@ struct RayCells {
 /// `tree` gives the key grid and the ray traversal (OcTree::computeRayKeys()); only read.
 RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
                   const octomap::point3d& origin, double max_range_m);
+
+/// The centres of the distinct cells of `tree`'s key grid that the points (camera frame, moved
+/// by T_W_C) fall in, each once, in the order first met; points outside the grid are dropped.
+/// (The same cloud as collecting the keys in an octomap::KeySet, without its per-key nodes.)
+octomap::Pointcloud distinctCellCentres(const octomap::OcTree& tree,
+                                        const std::vector<Eigen::Vector3f>& points_C,
+                                        const Eigen::Isometry3f& T_W_C);
 
 }  // namespace dynamap::plugin
