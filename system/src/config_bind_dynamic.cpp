@@ -59,7 +59,11 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addInt("dynamic.dense_min_region_px", &c.dense_min_region_px, 1, 1000000);
   schema.addDouble("dynamic.dense_depth_range_m", &c.dense_depth_range_m, 0.001, 10.0);
   schema.addDouble("dynamic.dense_grow_m", &c.dense_grow_m, 0.0, 10.0);
+  schema.addDouble("dynamic.dense_barrier_step_m", &c.dense_barrier_step_m, 0.0, 10.0);
+  schema.addDouble("dynamic.dense_max_depth_m", &c.dense_max_depth_m, 0.0, 100.0);
   schema.addBool("dynamic.mover_tracks", &c.mover_tracks);
+  schema.addBool("dynamic.hold_moved_objects", &c.hold_moved_objects);
+  schema.addBool("dynamic.mover_follow_anchors", &c.mover_follow_anchors);
   schema.addInt("dynamic.mover_view_frames", &c.mover_view_frames, 0, 120);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);

@@ -135,6 +135,41 @@ TEST(DepthCheck, DecidedObjectsAreLeftAlone) {
   EXPECT_EQ(cv::countNonZero(moved), 0);
 }
 
+TEST(DepthCheck, DepthStepsMarkBothSidesOfAStepButNotASlope) {
+  cv::Mat depth(40, 40, CV_32F);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 40; ++x) depth.at<float>(y, x) = 2.f + 0.005f * x;  // 5 mm a pixel
+  depth(cv::Rect(20, 0, 20, 40)) += 0.1f;  // a 10 cm step between columns 19 and 20
+  const cv::Mat steps = depthSteps(depth, 0.03);
+  EXPECT_EQ(cv::countNonZero(steps.colRange(19, 21)), 80);
+  EXPECT_EQ(cv::countNonZero(steps.colRange(0, 18)), 0);
+  EXPECT_EQ(cv::countNonZero(steps.colRange(22, 40)), 0);
+}
+
+TEST(DepthCheck, GrowthStopsAtADepthStepWithABarrier) {
+  // A wall 4 m away; a still block (the teddy) 1.5 m away in both frames; a chair 1.6 m away
+  // that moved in beside it, touching it in the image: within the 15 cm fixed range of each
+  // other, but apart by a 10 cm step.
+  const cv::Rect teddy(320, 100, 120, 250), chair(200, 150, 120, 200);
+  cv::Mat before(480, 640, CV_32F, cv::Scalar(4.f));
+  before(teddy).setTo(1.5f);
+  cv::Mat now = before.clone();
+  now(chair).setTo(1.6f);
+  DepthView view = DepthHistory::halfView(before, 0);
+  view.T_W_C = cv::Matx44d::eye();
+  const cv::Vec4d K(535.4, 539.2, 320.1, 247.6);
+  SeenThroughOptions o;
+  const auto grown = [&](double barrier) {
+    o.barrier_step_m = barrier;
+    return seenThroughRegions(now, cv::Matx44d::eye(), K, view, cv::Mat(), o);
+  };
+  const cv::Mat free = grown(0.0), barred = grown(0.03);
+  EXPECT_GT(cv::countNonZero(free(chair)), 0.9 * chair.area());
+  EXPECT_GT(cv::countNonZero(free(teddy)), 0.5 * teddy.area());  // the teddy taken along
+  EXPECT_GT(cv::countNonZero(barred(chair)), 0.9 * chair.area());
+  EXPECT_EQ(cv::countNonZero(barred(teddy)), 0);
+}
+
 TEST(DepthHistory, KeepsRecentViewsAndFindsTheNewestOldEnoughOne) {
   DepthHistory history(4);
   const cv::Mat depth(8, 8, CV_32FC1, cv::Scalar(1.f));

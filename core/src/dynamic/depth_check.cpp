@@ -96,7 +96,7 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
     for (int x = r.x + step / 2; x < r.x + r.width; x += step) {
       if (!region.empty() && region.at<uchar>(y, x) == 0) continue;
       const float z = interiorDepth(depth_m, x, y);
-      if (z <= 0.f) continue;
+      if (z <= 0.f || (o.max_depth_m > 0.0 && z > o.max_depth_m)) continue;
       const cv::Vec4d p_C((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z, 1.0);
       const cv::Vec4d p_V = T_V_C * p_C;
       if (p_V[2] <= 0.1) continue;
@@ -146,6 +146,27 @@ const DepthView* DepthHistory::newestUpTo(long last_frame) const {
   return nullptr;
 }
 
+cv::Mat depthSteps(const cv::Mat& depth_m, double step_m) {
+  cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
+  const auto step = [step_m](float a, float b) {
+    return a <= 0.f || b <= 0.f || std::abs(a - b) > step_m + 0.01 * std::min(a, b);
+  };
+  for (int y = 0; y < depth_m.rows; ++y) {
+    const float* row = depth_m.ptr<float>(y);
+    const float* below = y + 1 < depth_m.rows ? depth_m.ptr<float>(y + 1) : nullptr;
+    uchar* o = out.ptr<uchar>(y);
+    uchar* o_below = below != nullptr ? out.ptr<uchar>(y + 1) : nullptr;
+    for (int x = 0; x < depth_m.cols; ++x) {
+      if (x + 1 < depth_m.cols && step(row[x], row[x + 1])) o[x] = o[x + 1] = 1;
+      if (below == nullptr) continue;
+      if (step(row[x], below[x])) o[x] = o_below[x] = 1;
+      if (x + 1 < depth_m.cols && step(row[x], below[x + 1])) o[x] = o_below[x + 1] = 1;
+      if (x > 0 && step(row[x], below[x - 1])) o[x] = o_below[x - 1] = 1;
+    }
+  }
+  return out;
+}
+
 cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                            const DepthView& view, const cv::Mat& exclude,
                            const SeenThroughOptions& o, int* regions) {
@@ -176,6 +197,10 @@ cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, con
     cv::Mat flood = cv::Mat::zeros(roi.height + 2, roi.width + 2, CV_8UC1);
     if (!exclude.empty()) flood(cv::Rect(1, 1, roi.width, roi.height)).setTo(1, exclude(roi));
     const cv::Mat depth_roi = depth_m(roi).clone();
+    if (o.barrier_step_m > 0.0) {
+      cv::Mat inner = flood(cv::Rect(1, 1, roi.width, roi.height));
+      inner.setTo(1, depthSteps(depth_roi, o.barrier_step_m));
+    }
     const cv::Scalar tol(o.depth_range_m);
     for (int y = tight.y + step / 2; y < tight.y + tight.height; y += step) {
       for (int x = tight.x + step / 2; x < tight.x + tight.width; x += step) {

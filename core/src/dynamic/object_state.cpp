@@ -1,5 +1,7 @@
 #include "object_state.hpp"
 
+#include "dynamap/core/dynamic/depth_check.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -44,12 +46,24 @@ bool countedStill(const ObjectTrack* prev, const DynamicConfig& c) {
   return prev != nullptr && prev->quiet_frames >= c.static_confirm_frames;
 }
 
+/// The still limit of an object's anchors in pixels: the pose noise, or a still person's
+/// postural sway (static_anchor_m) seen at its depth, whichever is larger (0 = none).
+double stillLimitPx(const ObjectDecision& d, const cv::Vec4d& K, const DynamicConfig& c) {
+  const double sway_px = d.depth_m > 0.0 && K[0] > 0.0 ? c.static_anchor_m * K[0] / d.depth_m : 0.0;
+  return c.static_anchor_px > 0.0 ? std::max(c.static_anchor_px, sway_px) : 0.0;
+}
+
+/// Its anchors are off by twice the still limit, and by more than the sensor's depth noise
+/// could make them (3 sigma of the difference of two depths): a wall 4 m away is no mover.
+bool movedBeyondNoise(const ObjectDecision& d, const cv::Vec4d& K, const DynamicConfig& c) {
+  const double noise_z = 3.0 * std::sqrt(2.0) * depthNoiseM(d.depth_m);
+  return d.anchor.median_px > 2.0 * stillLimitPx(d, K, c) ||
+         std::abs(d.anchor.median_dz_m) > 2.0 * std::max(c.static_anchor_depth_m, noise_z);
+}
+
 AnchorVerdict judgeAnchors(const ObjectDecision& d, const ObjectTrack* prev, const cv::Vec4d& K,
                            const DynamicConfig& c) {
-  // The pose noise in pixels, or a still person's postural sway (static_anchor_m) seen at its
-  // depth, whichever is larger.
-  const double sway_px = d.depth_m > 0.0 && K[0] > 0.0 ? c.static_anchor_m * K[0] / d.depth_m : 0.0;
-  const double tau = c.static_anchor_px > 0.0 ? std::max(c.static_anchor_px, sway_px) : 0.0;
+  const double tau = stillLimitPx(d, K, c);
   if (!(tau > 0.0 && d.anchor.points >= kAnchorMinPoints)) return AnchorVerdict::kNone;
   const double tau_z = c.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
   if (d.anchor.median_px <= tau && dz <= tau_z) return AnchorVerdict::kStill;
@@ -152,6 +166,23 @@ void holdUntilConfirmed(ObjectTrack& t, ObjectDecision& d, const Observation& ob
       t.moving && !evidenced && !obs.flagged && t.slow_moves == 0 && t.score < c.moving_ratio;
 }
 
+/// An object of another class that was seen to move stays masked until it has stood still for
+/// static_confirm_frames (hold_moved_objects): a pushed chair flags few points while it moves
+/// away from the camera, but its anchors drift off frame after frame. While held, anchors off by
+/// less than twice the limit start a new run from where it is now: it moved on since they were
+/// set, or stopped just there (else it would stay held for ever).
+void holdMovedUntilStill(ObjectTrack& t, const ObjectDecision& d, const ObjectTrack* prev,
+                         const Observation& obs, const DynamicConfig& c) {
+  const bool held_before = prev != nullptr && prev->seen_moving;
+  if (held_before && obs.anchors == AnchorVerdict::kUndecided) {
+    t.anchors = d.anchor.fresh;
+    t.quiet_frames = 0;
+  }
+  const bool moved_now = t.moving || obs.anchors == AnchorVerdict::kMoved;
+  t.seen_moving = moved_now || (held_before && t.quiet_frames < c.static_confirm_frames);
+  t.moving = t.moving || t.seen_moving;
+}
+
 }  // namespace
 
 ObjectTrack nextObjectState(ObjectDecision& d, const ObjectTrack* prev,
@@ -160,6 +191,7 @@ ObjectTrack nextObjectState(ObjectDecision& d, const ObjectTrack* prev,
   const Observation obs = observe(d, prev, evidence, config);
   d.moving_now = obs.movingNow();
   ObjectTrack t = startTrack(d, prev, obs, config);
+  t.anchors_moved = obs.anchors == AnchorVerdict::kMoved && movedBeyondNoise(d, evidence.K, config);
   smoothEvidence(t, prev, obs, config);
   countQuietFrames(t, d, prev, obs, evidence.background_fit, config);
   // A person confirmed still whose flags his anchors do not confirm (they drifted, but less than
@@ -168,6 +200,7 @@ ObjectTrack nextObjectState(ObjectDecision& d, const ObjectTrack* prev,
   const bool unconfirmed_flags = obs.confirmed_before && obs.anchored() && !moved;
   d.motion_now = (obs.flagged && !unconfirmed_flags) || moved || t.moving;
   if (high_dynamic) holdUntilConfirmed(t, d, obs, config);
+  if (!high_dynamic && config.hold_moved_objects) holdMovedUntilStill(t, d, prev, obs, config);
   d.moving = t.moving;
   d.quiet_frames = t.quiet_frames;
   return t;

@@ -122,6 +122,13 @@ struct DynamicConfig {
   int dense_min_region_px = 800;
   double dense_depth_range_m = 0.15;
   double dense_grow_m = 0.5;
+  /// Growth stops at a step in depth between neighbouring pixels larger than this plus 1 % of
+  /// the depth (m; 0 = only the fixed range bounds it): a mover next to a static object at its
+  /// depth does not take it.
+  double dense_barrier_step_m = 0.0;
+  /// Pixels deeper than this are not judged (m; 0 = no limit): the sensor's depth at 6-8 m is
+  /// off by decimetres from frame to frame; the maps take depth up to 4 m.
+  double dense_max_depth_m = 0.0;
   /// The dense check's regions become class-less objects ("mover", ClassTable::kMover) that
   /// fusion tracks as it tracks people (needs mode both): a pushed box stays masked between the
   /// frames the check finds it in, and is kept once it has stood still for static_confirm_frames
@@ -131,6 +138,15 @@ struct DynamicConfig {
   /// Movers are found against the depth this many frames back (0 = dense_check_frames). 12
   /// finds far more of a pushed chair or box (BENCHMARKS.md).
   int mover_view_frames = 0;
+  /// An object of another class (a chair) that was seen to move (its flags, or its anchors off
+  /// by twice the still limit) is masked until it has stood still for static_confirm_frames, as
+  /// a person is (false: only while its smoothed flags say it moves). A chair pushed away from
+  /// the camera flags few points in most frames, while its anchors drift frame after frame.
+  bool hold_moved_objects = false;
+  /// A mover the depth check no longer finds is followed (carried by the flow) for as long as
+  /// its own points keep moving off their world anchors, not only track_max_missed_frames: a box
+  /// pushed straight away from the camera is never seen through.
+  bool mover_follow_anchors = false;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
   /// Such a carried box at the image border whose centre shows depth, but none within 0.5 m of

@@ -38,6 +38,9 @@ struct DepthCheckOptions {
   /// centimetres at 3 m towards the image borders on a Kinect).
   double relative_margin = 0.02;
   int border_px = 16;  ///< pixels this close to the image border are not sampled
+  /// Pixels deeper than this are not sampled (m; 0 = no limit): a structured-light sensor's
+  /// depth at 6-8 m is off by decimetres from frame to frame (the teddy room's far wall).
+  double max_depth_m = 0.0;
 };
 
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
@@ -73,7 +76,16 @@ struct SeenThroughOptions {
   /// Growth stays inside the group's box grown by this much (m, at the group's depth) on each
   /// side: a seen-through strip is often just the leading edge of what moved.
   double grow_m = 0.5;
+  /// Growth does not cross a step in depth between neighbouring pixels larger than this plus
+  /// 1 % of the depth (m; 0 = no limit): a chair pushed past the teddy at its depth is one
+  /// surface within the fixed range, but the two meet at a step.
+  double barrier_step_m = 0.0;
 };
+
+/// Pixels of `depth_m` (CV_32FC1, m) next to a neighbour (right, below, or diagonal) whose depth
+/// differs by more than step_m + 1 % of the nearer depth, or next to a pixel without depth;
+/// CV_8UC1, 1 = a step (both sides of it).
+cv::Mat depthSteps(const cv::Mat& depth_m, double step_m);
 
 /// The dense geometric check, which needs no detector: the pixels of the current depth (pose
 /// T_W_C) that `view` saw through (it saw a surface behind them, beyond the noise margin: they

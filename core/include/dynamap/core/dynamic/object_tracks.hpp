@@ -58,6 +58,9 @@ struct ObjectTrack {
   /// each doubles the quiet frames it needs to be kept (at most 16 x).
   int slow_moves = 0;
   bool anchors_still = false;  ///< its anchors were within the still limit
+  bool anchors_moved = false;  ///< its anchors were off by twice the still limit
+  /// Seen to move, and not yet still for static_confirm_frames since (hold_moved_objects).
+  bool seen_moving = false;
   bool moving = false;
 };
 

@@ -26,6 +26,7 @@ struct ObjectDecision {
   double weight = 0.0;      ///< class motion prior
   int points = 0;           ///< tracked points on the object's own pixels
   int dynamic_points = 0;   ///< of which dynamic
+  int proven_points = 0;    ///< of which landmarks the pose from proven-static ones held
   bool moving_now = false;  ///< evidence in this frame
   bool moving = false;      ///< after hysteresis (what is masked)
   bool carried = false;     ///< not detected in this frame: its track carried by the flow
@@ -112,6 +113,8 @@ class RegionFusion {
   /// Drops a high-dynamic detection that overlaps (IoU >= 0.6) a better-scored detection of a
   /// class that does not move by itself: the detector's two labels of one object.
   std::vector<Detection> oneLabelPerObject(const std::vector<Detection>& in) const;
+  /// A new mover whose points are mostly proven static: not something that moved in.
+  bool provenStaticMover(const ObjectDecision& d) const;
   /// A decision on `detection` with its class's weight, nothing measured yet.
   ObjectDecision newDecision(const Detection& detection) const;
   /// Moves every track's box by the median flow of the points inside it.
