@@ -59,5 +59,17 @@ TEST(DynamicConfigBinding, ExampleClassTableFileLoadsAndItsModelsExist) {
   EXPECT_EQ(ClassTable(c.dynamic).weight(ClassTable::classIndex("chair")), 0.5);
 }
 
+TEST(DynamicConfigBinding, MoversConfigTurnsOnTheMoverKeys) {
+  const AppConfig c = loadAppConfig((test::sourceDir() / "config/movers.yaml").string(), {});
+  EXPECT_TRUE(c.dynamic.mover_tracks);
+  EXPECT_EQ(c.dynamic.mover_view_frames, 12);
+  EXPECT_TRUE(c.dynamic.mover_follow_anchors);
+  EXPECT_TRUE(c.dynamic.hold_moved_objects);
+  EXPECT_DOUBLE_EQ(c.dynamic.dense_barrier_step_m, 0.03);
+  const AppConfig d = loadAppConfig((test::sourceDir() / "config/default.yaml").string(), {});
+  EXPECT_FALSE(d.dynamic.mover_tracks || d.dynamic.mover_follow_anchors ||
+               d.dynamic.hold_moved_objects);
+}
+
 }  // namespace
 }  // namespace dynamap
