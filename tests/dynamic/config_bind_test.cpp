@@ -67,8 +67,8 @@ TEST(DynamicConfigBinding, MoversConfigTurnsOnTheMoverKeys) {
   EXPECT_TRUE(c.dynamic.hold_moved_objects);
   EXPECT_DOUBLE_EQ(c.dynamic.dense_barrier_step_m, 0.03);
   const AppConfig d = loadAppConfig((test::sourceDir() / "config/default.yaml").string(), {});
-  EXPECT_FALSE(d.dynamic.mover_tracks || d.dynamic.mover_follow_anchors ||
-               d.dynamic.hold_moved_objects);
+  EXPECT_FALSE(d.dynamic.mover_tracks || d.dynamic.mover_follow_anchors);
+  EXPECT_TRUE(d.dynamic.hold_moved_objects);
 }
 
 }  // namespace

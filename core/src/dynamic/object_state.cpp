@@ -170,7 +170,8 @@ void holdUntilConfirmed(ObjectTrack& t, ObjectDecision& d, const Observation& ob
 /// static_confirm_frames (hold_moved_objects): a pushed chair flags few points while it moves
 /// away from the camera, but its anchors drift off frame after frame. While held, anchors off by
 /// less than twice the limit start a new run from where it is now: it moved on since they were
-/// set, or stopped just there (else it would stay held for ever).
+/// set, or stopped just there (else it would stay held for ever). A walker passing in front of a
+/// chair moves its points and flags: under a person's box, nothing starts a hold.
 void holdMovedUntilStill(ObjectTrack& t, const ObjectDecision& d, const ObjectTrack* prev,
                          const Observation& obs, const DynamicConfig& c) {
   const bool held_before = prev != nullptr && prev->seen_moving;
@@ -178,7 +179,8 @@ void holdMovedUntilStill(ObjectTrack& t, const ObjectDecision& d, const ObjectTr
     t.anchors = d.anchor.fresh;
     t.quiet_frames = 0;
   }
-  const bool moved_now = t.moving || obs.anchors == AnchorVerdict::kMoved;
+  // Under a person's box its points and flags may be the person's: that starts no hold.
+  const bool moved_now = !d.under_person && (t.moving || obs.anchors == AnchorVerdict::kMoved);
   t.seen_moving = moved_now || (held_before && t.quiet_frames < c.static_confirm_frames);
   t.moving = t.moving || t.seen_moving;
 }

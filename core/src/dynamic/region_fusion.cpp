@@ -17,6 +17,7 @@ namespace {
 constexpr int kAnchorWindowPx = 8;
 constexpr float kAnchorWindowM = 0.1f;  ///< ... within this depth step
 constexpr float kMatchIou = 0.3f;       ///< a detection continues a track above this IoU
+constexpr float kUnderPersonShare = 0.3f;   ///< underPerson(): share of its box a person covers
 constexpr int kMoverMinProven = 8;            ///< provenStaticMover(): proven-static points,
 constexpr int kMoverProvenShareInverse = 10;  ///< ... and at least 1/10 of its points
 constexpr float kSameObjectIou = 0.6f;  ///< two labels of one object (oneLabelPerObject)
@@ -202,6 +203,21 @@ void RegionFusion::applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, con
   result.objects.push_back(d);
 }
 
+bool RegionFusion::underPerson(const Detection& object,
+                               const std::vector<Detection>& detections) const {
+  if (classes_.isHighDynamic(object.class_id)) return false;
+  const float area = object.box.area();
+  const auto covers = [&](int class_id, const cv::Rect2f& box) {
+    return classes_.isHighDynamic(class_id) && class_id != ClassTable::kMover && area > 0.f &&
+           (box & object.box).area() >= kUnderPersonShare * area;
+  };
+  for (const auto& o : detections)
+    if (covers(o.class_id, o.box)) return true;
+  for (const auto& t : tracks_)  // people not detected in this frame, their boxes moved by the flow
+    if (covers(t.class_id, t.box)) return true;
+  return false;
+}
+
 bool RegionFusion::provenStaticMover(const ObjectDecision& d) const {
   // A new mover (a seen-through region grown into its surface) that holds landmarks the pose
   // from proven-static landmarks kept in this frame, with their depth, is a static surface the
@@ -244,6 +260,7 @@ std::vector<bool> RegionFusion::fuseDetections(Frame& f, const std::vector<Detec
     const cv::Rect box = clampRect(d.detection.box, f.depth_m.size());
     if (box.area() <= 0) continue;
     int track = track_of[k];
+    d.under_person = underPerson(d.detection, detections);
     cv::Mat region = detectedRegion(f, box, d, track);
     if (track < 0 && provenStaticMover(d)) continue;
     if (f.mode == FusionMode::kDetector) {
@@ -260,6 +277,7 @@ std::vector<bool> RegionFusion::fuseDetections(Frame& f, const std::vector<Detec
 }
 
 void RegionFusion::carryUndetected(Frame& f, const std::vector<bool>& matched,
+                                   const std::vector<Detection>& detections,
                                    std::vector<ObjectTrack>& next, FusionResult& result) const {
   for (std::size_t t = 0; t < tracks_.size(); ++t) {
     const ObjectTrack& track = tracks_[t];
@@ -270,6 +288,7 @@ void RegionFusion::carryUndetected(Frame& f, const std::vector<bool>& matched,
     }
     ObjectDecision d = newDecision(Detection{track.box, track.class_id, 0.f});
     d.carried = true;
+    d.under_person = underPerson(d.detection, detections);
     cv::Mat region = objectRegion(f, box, d, &track);
     next.push_back(nextObjectState(d, &track, f.evidence, config_,
                                    classes_.isHighDynamic(d.detection.class_id)));
@@ -330,7 +349,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
         fuseDetections(f, oneLabelPerObject(all_detections), next, result);
     // Objects the detector did not report in this frame: a person seen a moment ago keeps its
     // mask (and its evidence) for a few frames, its box moved with the flow.
-    if (mode == FusionMode::kBoth) carryUndetected(f, matched, next, result);
+    if (mode == FusionMode::kBoth) carryUndetected(f, matched, all_detections, next, result);
   }
   tracks_ = std::move(next);
   finishMasks(f, result);

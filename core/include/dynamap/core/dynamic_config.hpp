@@ -142,7 +142,8 @@ struct DynamicConfig {
   /// by twice the still limit) is masked until it has stood still for static_confirm_frames, as
   /// a person is (false: only while its smoothed flags say it moves). A chair pushed away from
   /// the camera flags few points in most frames, while its anchors drift frame after frame.
-  bool hold_moved_objects = false;
+  /// Under a person's box nothing starts a hold (a walker passing in front of a chair).
+  bool hold_moved_objects = true;
   /// A mover the depth check no longer finds is followed (carried by the flow) for as long as
   /// its own points keep moving off their world anchors, not only track_max_missed_frames: a box
   /// pushed straight away from the camera is never seen through.

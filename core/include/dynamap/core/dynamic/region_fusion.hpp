@@ -27,6 +27,9 @@ struct ObjectDecision {
   int points = 0;           ///< tracked points on the object's own pixels
   int dynamic_points = 0;   ///< of which dynamic
   int proven_points = 0;    ///< of which landmarks the pose from proven-static ones held
+  /// A person's box (a high-dynamic detection) covers much of its box: its points and flags
+  /// may be the person's (a walker passing in front of a chair).
+  bool under_person = false;
   bool moving_now = false;  ///< evidence in this frame
   bool moving = false;      ///< after hysteresis (what is masked)
   bool carried = false;     ///< not detected in this frame: its track carried by the flow
@@ -113,6 +116,9 @@ class RegionFusion {
   /// Drops a high-dynamic detection that overlaps (IoU >= 0.6) a better-scored detection of a
   /// class that does not move by itself: the detector's two labels of one object.
   std::vector<Detection> oneLabelPerObject(const std::vector<Detection>& in) const;
+  /// True if a person's box (a high-dynamic detection or last frame's track, not a mover)
+  /// covers kUnderPersonShare of the box of `object` (of another class).
+  bool underPerson(const Detection& object, const std::vector<Detection>& detections) const;
   /// A new mover whose points are mostly proven static: not something that moved in.
   bool provenStaticMover(const ObjectDecision& d) const;
   /// A decision on `detection` with its class's weight, nothing measured yet.
@@ -124,7 +130,8 @@ class RegionFusion {
   std::vector<bool> fuseDetections(Frame& f, const std::vector<Detection>& detections,
                                    std::vector<ObjectTrack>& next, FusionResult& result) const;
   /// Decides and masks the tracks no detection continued (for track_max_missed_frames).
-  void carryUndetected(Frame& f, const std::vector<bool>& matched, std::vector<ObjectTrack>& next,
+  void carryUndetected(Frame& f, const std::vector<bool>& matched,
+                       const std::vector<Detection>& detections, std::vector<ObjectTrack>& next,
                        FusionResult& result) const;
   /// Confirmed objects out of the mask, clusters grown, the masks' margins.
   void finishMasks(Frame& f, FusionResult& result) const;
