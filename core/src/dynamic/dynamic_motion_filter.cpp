@@ -88,7 +88,6 @@ SeenThroughOptions seenThroughOptions(const DynamicConfig& c) {
   o.depth_range_m = c.dense_depth_range_m;
   o.grow_m = c.dense_grow_m;
   o.barrier_step_m = c.dense_barrier_step_m;
-  o.check.max_depth_m = c.dense_max_depth_m;
   return o;
 }
 

@@ -126,9 +126,6 @@ struct DynamicConfig {
   /// the depth (m; 0 = only the fixed range bounds it): a mover next to a static object at its
   /// depth does not take it.
   double dense_barrier_step_m = 0.0;
-  /// Pixels deeper than this are not judged (m; 0 = no limit): the sensor's depth at 6-8 m is
-  /// off by decimetres from frame to frame; the maps take depth up to 4 m.
-  double dense_max_depth_m = 0.0;
   /// The dense check's regions become class-less objects ("mover", ClassTable::kMover) that
   /// fusion tracks as it tracks people (needs mode both): a pushed box stays masked between the
   /// frames the check finds it in, and is kept once it has stood still for static_confirm_frames

@@ -38,9 +38,6 @@ struct DepthCheckOptions {
   /// centimetres at 3 m towards the image borders on a Kinect).
   double relative_margin = 0.02;
   int border_px = 16;  ///< pixels this close to the image border are not sampled
-  /// Pixels deeper than this are not sampled (m; 0 = no limit): a structured-light sensor's
-  /// depth at 6-8 m is off by decimetres from frame to frame (the teddy room's far wall).
-  double max_depth_m = 0.0;
 };
 
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
