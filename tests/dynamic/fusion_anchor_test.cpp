@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "fusion_point_grid.hpp"
 
 namespace dynamap::fusion_anchor_test {
 namespace {
@@ -59,15 +60,9 @@ TEST(PointAnchors, StaticPointsStayPutMovedOnesShowInPixelsAndDepth) {
 template <typename DepthOf>
 double keptShare(const DynamicConfig& c, int frames, DepthOf z, bool with_ids) {
   const cv::Rect person(280, 120, 90, 260);
-  std::vector<cv::Point2f> points;
-  for (int y = 5; y < 480; y += 10)
-    for (int x = 5; x < 640; x += 10) points.emplace_back(float(x), float(y));
+  const std::vector<cv::Point2f> points = test::pointGrid();
   const std::vector<std::uint8_t> quiet(points.size(), 0);
-  FusionEvidence ev;
-  ev.has_pose = true;
-  ev.K = kK;
-  if (with_ids)
-    for (std::size_t i = 0; i < points.size(); ++i) ev.point_ids.push_back(i);
+  const FusionEvidence ev = test::stillCameraEvidence(points.size(), with_ids);
   RegionFusion fusion(c, ClassTable(c));
   const Detection det{cv::Rect2f(270, 110, 110, 280), 0, 0.9f};
   int kept = 0;

@@ -5,11 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "fusion_point_grid.hpp"
 
 namespace dynamap::fusion_hold_test {
 namespace {
 
-const cv::Vec4d kK(535.4, 539.2, 320.1, 247.6);
 const cv::Rect kChair(260, 200, 120, 200);
 constexpr int kMovingFrames = 40;  ///< 1.5 cm a frame away from the camera (0.45 m/s at 30 Hz)
 constexpr int kStillFrames = 40;
@@ -18,14 +18,9 @@ constexpr int kStillFrames = 40;
 /// points keep their ids and pixels and are never flagged. With `person`, a person's box
 /// covers the chair's.
 std::vector<bool> maskedFrames(const DynamicConfig& c, bool person = false) {
-  std::vector<cv::Point2f> points;
-  for (int y = 5; y < 480; y += 10)
-    for (int x = 5; x < 640; x += 10) points.emplace_back(float(x), float(y));
+  const std::vector<cv::Point2f> points = test::pointGrid();
   const std::vector<std::uint8_t> quiet(points.size(), 0);
-  FusionEvidence ev;
-  ev.has_pose = true;
-  ev.K = kK;
-  for (std::size_t i = 0; i < points.size(); ++i) ev.point_ids.push_back(i);
+  const FusionEvidence ev = test::stillCameraEvidence(points.size(), true);
   RegionFusion fusion(c, ClassTable(c));
   const int chair_class = ClassTable::classIndex("chair");
   std::vector<Detection> detections{{cv::Rect2f(kChair), chair_class, 0.8f}};
