@@ -59,6 +59,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
+  schema.addInt("tracking.ba_fixed_covisible", &c.ba_fixed_covisible, 0, 1000);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
   schema.addInt("tracking.ba_global_every_keyframes", &c.ba_global_every_keyframes, 0, 1000000);
   schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);

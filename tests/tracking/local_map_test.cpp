@@ -122,6 +122,32 @@ TEST(LocalMap, WindowHoldsOlderCovisibleKeyframesFixedAndLeavesBadLandmarksOut) 
   EXPECT_TRUE(single.snapshotWindow(8, 1).keyframe_ids.empty());  // nothing free to solve
 }
 
+TEST(LocalMap, ARevisitsWindowHoldsTheOldKeyframesThatSawItsLandmarksFixed) {
+  LocalMap map;
+  buildMap(map);
+  // kf4 and kf5 come back to kf0's view: kf5 sees 0 1 2 again, kf4 sees 8.
+  map.addKeyframe(2.0, poseOf(0), {{8, Eigen::Vector2d(80, 5), 3.0}});
+  map.addKeyframe(2.5, poseOf(0),
+                  {{0, Eigen::Vector2d(0, 5), 3.0},
+                   {1, Eigen::Vector2d(10, 5), 3.0},
+                   {2, Eigen::Vector2d(20, 5), 3.0}});
+  // Without older observers the window (kf5 free, kf4 before it) holds kf5 alone: nothing
+  // ties landmarks 0 1 2 to the keyframes that made them.
+  BaWindow w = map.snapshotWindow(1, 0);
+  EXPECT_EQ(w.keyframe_ids, (std::vector<std::uint64_t>{5}));
+  EXPECT_EQ(w.observations.size(), 3u);
+  // Two older observers: kf0 (shares 0 1 2) and kf1 (shares 2), fixed, with their observations.
+  w = map.snapshotWindow(1, 0, 2);
+  EXPECT_EQ(w.keyframe_ids, (std::vector<std::uint64_t>{0, 1, 5}));
+  EXPECT_EQ(w.fixed, (std::vector<std::uint8_t>{1, 1, 0}));
+  EXPECT_EQ(w.observations.size(), 7u);  // kf0: 0 1 2; kf1: 2; kf5: 0 1 2
+  EXPECT_EQ(sorted(w.landmark_ids), (std::vector<std::uint64_t>{0, 1, 2}));
+  // One: the one sharing the most.
+  w = map.snapshotWindow(1, 0, 1);
+  EXPECT_EQ(w.keyframe_ids, (std::vector<std::uint64_t>{0, 5}));
+  EXPECT_EQ(w.fixed, (std::vector<std::uint8_t>{1, 0}));
+}
+
 TEST(LocalMap, ApplyWritesFreePosesAndPointsAndReportsOnlyMovedKeyframes) {
   LocalMap map;
   buildMap(map);

@@ -114,7 +114,7 @@ void LocalBundleAdjuster::stop() {
 
 BaWindow LocalBundleAdjuster::snapshot(bool global) const {
   const int window = global ? static_cast<int>(map_.keyframeCount()) : config_.ba_window;
-  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes);
+  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes, config_.ba_fixed_covisible);
   w.global = global;
   return w;
 }
@@ -138,7 +138,8 @@ void LocalBundleAdjuster::queueUpdates(const std::vector<PoseUpdate>& moved) {
 
 void LocalBundleAdjuster::runOnce(int window_keyframes, int max_iterations) {
   BaWindow window = window_keyframes > 0
-                        ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes)
+                        ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes,
+                                              config_.ba_fixed_covisible)
                         : snapshot(false);
   TrackerConfig config = config_;
   if (max_iterations > 0) config.ba_max_iterations = max_iterations;

@@ -107,7 +107,33 @@ void LocalMap::keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector
   for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].keyframes;
 }
 
-BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
+// Keyframes older than `first` that see the window's landmarks (a revisit re-found them), the
+// `limit` sharing the most, oldest first: held fixed, they keep the window's landmarks where
+// the old keyframes put them, so a revisit's window cannot move the old map's landmarks away
+// from the keyframes that made them.
+std::vector<int> LocalMap::olderCovisibleLocked(
+    int first, int limit, const std::unordered_map<std::uint64_t, int>& lm_index) const {
+  std::vector<std::pair<int, int>> shared;  // (landmarks shared, keyframe)
+  if (limit <= 0) return {};
+  for (int k = 0; k < first; ++k) {
+    const auto& kf = keyframes_[static_cast<std::size_t>(k)];
+    if (kf.culled) continue;
+    int count = 0;
+    for (const auto& o : kf.observations) count += lm_index.count(o.landmark_id) != 0 ? 1 : 0;
+    if (count > 0) shared.emplace_back(count, k);
+  }
+  const auto keep = std::min(shared.size(), static_cast<std::size_t>(limit));
+  std::partial_sort(shared.begin(), shared.begin() + static_cast<std::ptrdiff_t>(keep),
+                    shared.end(), [](const auto& a, const auto& b) {
+                      return a.first != b.first ? a.first > b.first : a.second < b.second;
+                    });
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < keep; ++i) ids.push_back(shared[i].second);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+BaWindow LocalMap::snapshotWindow(int window, int fixed, int older_covisible) const {
   std::lock_guard<std::mutex> lock(mutex_);
   BaWindow w;
   w.generation = generation_;
@@ -135,7 +161,9 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed) const {
       }
     });
   }
-  for (int k = first; k < n; ++k) {
+  std::vector<int> observers = olderCovisibleLocked(first, older_covisible, lm_index);
+  for (int k = first; k < n; ++k) observers.push_back(k);
+  for (const int k : observers) {
     const auto& kf = keyframes_[static_cast<std::size_t>(k)];
     if (kf.culled) continue;
     const int kf_index = static_cast<int>(w.keyframe_ids.size());

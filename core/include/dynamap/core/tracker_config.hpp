@@ -129,6 +129,10 @@ struct TrackerConfig {
   bool ba_lockstep = true;
   int ba_window = 8;           ///< keyframes optimised together
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
+  /// Up to this many keyframes older than the window that see its landmarks (a revisit found
+  /// them again) are held fixed in the local BA, so it keeps the old map's landmarks where the
+  /// old keyframes put them. 0: only the window and the keyframes just before it.
+  int ba_fixed_covisible = 0;
   int ba_max_iterations = 10;
   /// Every this many keyframes the BA thread optimises every keyframe instead of the newest
   /// ba_window (stage "ba_global"), and the final BA only what came since (0 = never). Off:

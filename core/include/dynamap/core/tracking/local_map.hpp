@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <mutex>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -69,8 +70,9 @@ class LocalMap {
   void keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector<int>& out) const;
 
   /// The newest `window` keyframes; the oldest `fixed` of them and up to `window` older ones
-  /// that see the same landmarks are held fixed.
-  BaWindow snapshotWindow(int window, int fixed) const;
+  /// that see the same landmarks are held fixed, and so are up to `older_covisible` keyframes
+  /// older than those that see the same landmarks (those sharing the most).
+  BaWindow snapshotWindow(int window, int fixed, int older_covisible = 0) const;
   /// Writes optimised poses and points back; returns the moved keyframes. A window taken
   /// before a loop correction (solved.generation != generation()) is dropped: nothing moves.
   std::vector<PoseUpdate> apply(const BaWindow& solved);
@@ -109,6 +111,8 @@ class LocalMap {
   /// Culled keyframes back on their parents' poses; appends an update for each that moved to
   /// `updates` (may be null).
   void followParentsLocked(std::vector<PoseUpdate>* updates);
+  std::vector<int> olderCovisibleLocked(
+      int first, int limit, const std::unordered_map<std::uint64_t, int>& lm_index) const;
 
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
