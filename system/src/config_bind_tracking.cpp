@@ -47,7 +47,6 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_masked_share", &c.kf_max_masked_share, 0.0, 1.0);
   schema.addInt("tracking.kf_crowded_min_tracks", &c.kf_crowded_min_tracks, 0, 100000);
   schema.addDouble("tracking.kf_reuse_distance", &c.kf_reuse_distance, 0.0, 1.0);
-  schema.addDouble("tracking.kf_reuse_min_tracked_ratio", &c.kf_reuse_min_tracked_ratio, 0.0, 10.0);
   schema.addDouble("tracking.kf_reuse_max_uncovered_share", &c.kf_reuse_max_uncovered_share, 0.0,
                    1.0);
   schema.addDouble("tracking.kf_reuse_min_age_s", &c.kf_reuse_min_age_s, 0.0, 1e9);

@@ -217,10 +217,10 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
 
   const std::vector<FeatureTrack> saved = tracks_;
   mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C, sources));
-  // The map covers the view if the frame then tracks kf_reuse_min_tracked_ratio of
+  // The map covers the view if the frame then tracks kf_min_tracked_ratio of
   // min_tracked_features points, and RANSAC keeps twice min_inliers of them.
   const double needed =
-      config_.kf_reuse_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
+      config_.kf_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
   Eigen::Isometry3d T = T_W_C;
   int n = 0;
   if (static_cast<double>(tracks_.size()) < needed || !estimatePose(frame, T, n) ||

@@ -87,7 +87,7 @@ struct TrackerConfig {
   int kf_crowded_min_tracks = 45;
   /// Revisits: when a keyframe is due, the nearest keyframe within this share of the
   /// translation and rotation limits above becomes the reference again if the frame, with the
-  /// landmarks of the keyframes near it found again, tracks kf_reuse_min_tracked_ratio x
+  /// landmarks of the keyframes near it found again, tracks kf_min_tracked_ratio x
   /// min_tracked_features points (2 x min_inliers after RANSAC), instead of a new keyframe with
   /// new landmarks beside the old ones: keyframes grow with the space explored, not with time
   /// (0 = off).
@@ -100,8 +100,6 @@ struct TrackerConfig {
   /// At 1.5 teddy x10 made 82 keyframes instead of ~96, but crowd x10 ran away in its last
   /// pass (54 keyframes, 1.05 -> 2.14 cm; at 5: 89 keyframes, 1.04 cm).
   double kf_reuse_min_age_s = 5.0;
-  /// ... and only if the frame then tracks this share of min_tracked_features points.
-  double kf_reuse_min_tracked_ratio = 0.6;
   /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
   /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
   /// third of the landmarks in view (teddy x10: 144 keyframes; 3000 at 7: 96).
