@@ -146,6 +146,9 @@ TEST(LocalMap, ARevisitsWindowHoldsTheOldKeyframesThatSawItsLandmarksFixed) {
   w = map.snapshotWindow(1, 0, 1);
   EXPECT_EQ(w.keyframe_ids, (std::vector<std::uint64_t>{0, 5}));
   EXPECT_EQ(w.fixed, (std::vector<std::uint8_t>{1, 0}));
+  // Only those made 2.2 s or more before the newest (kf5 at 2.5 s): kf0 at 0 s, not kf1 at 0.5.
+  w = map.snapshotWindow(1, 0, 2, 2.2);
+  EXPECT_EQ(w.keyframe_ids, (std::vector<std::uint64_t>{0, 5}));
 }
 
 TEST(LocalMap, ApplyWritesFreePosesAndPointsAndReportsOnlyMovedKeyframes) {

@@ -114,7 +114,8 @@ void LocalBundleAdjuster::stop() {
 
 BaWindow LocalBundleAdjuster::snapshot(bool global) const {
   const int window = global ? static_cast<int>(map_.keyframeCount()) : config_.ba_window;
-  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes, config_.ba_fixed_covisible);
+  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes, config_.ba_fixed_covisible,
+                                   config_.kf_reuse_min_age_s);
   w.global = global;
   return w;
 }
@@ -137,10 +138,11 @@ void LocalBundleAdjuster::queueUpdates(const std::vector<PoseUpdate>& moved) {
 }
 
 void LocalBundleAdjuster::runOnce(int window_keyframes, int max_iterations) {
-  BaWindow window = window_keyframes > 0
-                        ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes,
-                                              config_.ba_fixed_covisible)
-                        : snapshot(false);
+  BaWindow window =
+      window_keyframes > 0
+          ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes,
+                                config_.ba_fixed_covisible, config_.kf_reuse_min_age_s)
+          : snapshot(false);
   TrackerConfig config = config_;
   if (max_iterations > 0) config.ba_max_iterations = max_iterations;
   ScopedStageTimer timer(timings_, "ba_final");

@@ -107,17 +107,19 @@ void LocalMap::keyframeCounts(const std::vector<std::uint64_t>& ids, std::vector
   for (std::size_t i = 0; i < ids.size(); ++i) out[i] = landmarks_[ids[i]].keyframes;
 }
 
-// Keyframes older than `first` that see the window's landmarks (a revisit re-found them), the
-// `limit` sharing the most, oldest first: held fixed, they keep the window's landmarks where
-// the old keyframes put them, so a revisit's window cannot move the old map's landmarks away
-// from the keyframes that made them.
+// Keyframes older than `first`, made `min_age_s` or more before the newest, that see the
+// window's landmarks (a revisit re-found them), the `limit` sharing the most, oldest first: held
+// fixed, they keep the window's landmarks where the old keyframes put them, so a revisit's window
+// cannot move the old map's landmarks away from the keyframes that made them.
 std::vector<int> LocalMap::olderCovisibleLocked(
-    int first, int limit, const std::unordered_map<std::uint64_t, int>& lm_index) const {
+    int first, int limit, double min_age_s,
+    const std::unordered_map<std::uint64_t, int>& lm_index) const {
   std::vector<std::pair<int, int>> shared;  // (landmarks shared, keyframe)
-  if (limit <= 0) return {};
+  if (limit <= 0 || keyframes_.empty()) return {};
+  const double newest_s = keyframes_.back().timestamp_s;
   for (int k = 0; k < first; ++k) {
     const auto& kf = keyframes_[static_cast<std::size_t>(k)];
-    if (kf.culled) continue;
+    if (kf.culled || kf.timestamp_s > newest_s - min_age_s) continue;
     int count = 0;
     for (const auto& o : kf.observations) count += lm_index.count(o.landmark_id) != 0 ? 1 : 0;
     if (count > 0) shared.emplace_back(count, k);
@@ -133,7 +135,8 @@ std::vector<int> LocalMap::olderCovisibleLocked(
   return ids;
 }
 
-BaWindow LocalMap::snapshotWindow(int window, int fixed, int older_covisible) const {
+BaWindow LocalMap::snapshotWindow(int window, int fixed, int older_covisible,
+                                  double older_min_age_s) const {
   std::lock_guard<std::mutex> lock(mutex_);
   BaWindow w;
   w.generation = generation_;
@@ -161,7 +164,8 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed, int older_covisible) co
       }
     });
   }
-  std::vector<int> observers = olderCovisibleLocked(first, older_covisible, lm_index);
+  std::vector<int> observers =
+      olderCovisibleLocked(first, older_covisible, older_min_age_s, lm_index);
   for (int k = first; k < n; ++k) observers.push_back(k);
   for (const int k : observers) {
     const auto& kf = keyframes_[static_cast<std::size_t>(k)];

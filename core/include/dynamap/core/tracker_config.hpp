@@ -129,9 +129,10 @@ struct TrackerConfig {
   bool ba_lockstep = true;
   int ba_window = 8;           ///< keyframes optimised together
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
-  /// Up to this many keyframes older than the window that see its landmarks (a revisit found
-  /// them again) are held fixed in the local BA, so it keeps the old map's landmarks where the
-  /// old keyframes put them. 0: only the window and the keyframes just before it.
+  /// Up to this many keyframes older than the window and kf_reuse_min_age_s older than its
+  /// newest keyframe that see its landmarks (a revisit found them again) are held fixed in the
+  /// local BA, so it keeps the old map's landmarks where the old keyframes put them. 0: only
+  /// the window and the keyframes just before it.
   int ba_fixed_covisible = 0;
   int ba_max_iterations = 10;
   /// Every this many keyframes the BA thread optimises every keyframe instead of the newest

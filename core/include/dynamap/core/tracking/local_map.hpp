@@ -71,8 +71,10 @@ class LocalMap {
 
   /// The newest `window` keyframes; the oldest `fixed` of them and up to `window` older ones
   /// that see the same landmarks are held fixed, and so are up to `older_covisible` keyframes
-  /// older than those that see the same landmarks (those sharing the most).
-  BaWindow snapshotWindow(int window, int fixed, int older_covisible = 0) const;
+  /// older than those, made `older_min_age_s` or more before the newest, that see the same
+  /// landmarks (those sharing the most: a revisit found them again).
+  BaWindow snapshotWindow(int window, int fixed, int older_covisible = 0,
+                          double older_min_age_s = 0.0) const;
   /// Writes optimised poses and points back; returns the moved keyframes. A window taken
   /// before a loop correction (solved.generation != generation()) is dropped: nothing moves.
   std::vector<PoseUpdate> apply(const BaWindow& solved);
@@ -112,7 +114,8 @@ class LocalMap {
   /// `updates` (may be null).
   void followParentsLocked(std::vector<PoseUpdate>* updates);
   std::vector<int> olderCovisibleLocked(
-      int first, int limit, const std::unordered_map<std::uint64_t, int>& lm_index) const;
+      int first, int limit, double min_age_s,
+      const std::unordered_map<std::uint64_t, int>& lm_index) const;
 
   mutable std::mutex mutex_;
   std::vector<Landmark> landmarks_;
