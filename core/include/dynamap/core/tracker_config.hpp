@@ -98,7 +98,12 @@ struct TrackerConfig {
   double kf_reuse_max_uncovered_share = 0.05;
   /// ... and only keyframes at least this old (s): a revisit, after the camera went elsewhere.
   /// At 1.5 teddy x10 made 82 keyframes instead of ~96, but crowd x10 ran away in its last
-  /// pass (54 keyframes, 1.05 -> 2.14 cm; at 5: 89 keyframes, 1.04 cm).
+  /// pass (54 keyframes, 1.05 -> 2.14 cm; at 5: 89 keyframes, 1.04 cm). The Bonn slice played
+  /// back comes to pass 1's crowded frames 3.3-3.6 s later and makes new keyframes there. With
+  /// ba_fixed_covisible 8, nine long runs (BENCHMARKS.md, session 64): at 5 / 4 / 3 s 512 / 496
+  /// / 482 keyframes, 3 / 3 / 7 lost frames; at 4 two of six teddy_dyn_crowd_dev starts kept a
+  /// walker (ghost 0.06 -> 3.6 %); 3 s without ba_fixed_covisible lost teddy_dyn_dev x10 in
+  /// pass 6 (0.96 -> 2.08 cm).
   double kf_reuse_min_age_s = 5.0;
   /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
   /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
@@ -132,8 +137,9 @@ struct TrackerConfig {
   /// Up to this many keyframes older than the window and kf_reuse_min_age_s older than its
   /// newest keyframe that see its landmarks (a revisit found them again) are held fixed in the
   /// local BA, so it keeps the old map's landmarks where the old keyframes put them. 0: only
-  /// the window and the keyframes just before it.
-  int ba_fixed_covisible = 0;
+  /// the window and the keyframes just before it (until session 64: nine long runs' mean ATE
+  /// 1.34 cm, with 8 1.26 cm at the same kf_reuse_min_age_s; BENCHMARKS.md, "Long runs").
+  int ba_fixed_covisible = 8;
   int ba_max_iterations = 10;
   /// Every this many keyframes the BA thread optimises every keyframe instead of the newest
   /// ba_window (stage "ba_global"), and the final BA only what came since (0 = never). Off:
