@@ -112,10 +112,13 @@ void LocalBundleAdjuster::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+BaWindow LocalBundleAdjuster::windowOf(int keyframes) const {
+  return map_.snapshotWindow(keyframes, config_.ba_fixed_keyframes, config_.ba_fixed_covisible,
+                             config_.kf_reuse_min_age_s);
+}
+
 BaWindow LocalBundleAdjuster::snapshot(bool global) const {
-  const int window = global ? static_cast<int>(map_.keyframeCount()) : config_.ba_window;
-  BaWindow w = map_.snapshotWindow(window, config_.ba_fixed_keyframes, config_.ba_fixed_covisible,
-                                   config_.kf_reuse_min_age_s);
+  BaWindow w = windowOf(global ? static_cast<int>(map_.keyframeCount()) : config_.ba_window);
   w.global = global;
   return w;
 }
@@ -138,11 +141,7 @@ void LocalBundleAdjuster::queueUpdates(const std::vector<PoseUpdate>& moved) {
 }
 
 void LocalBundleAdjuster::runOnce(int window_keyframes, int max_iterations) {
-  BaWindow window =
-      window_keyframes > 0
-          ? map_.snapshotWindow(window_keyframes, config_.ba_fixed_keyframes,
-                                config_.ba_fixed_covisible, config_.kf_reuse_min_age_s)
-          : snapshot(false);
+  BaWindow window = window_keyframes > 0 ? windowOf(window_keyframes) : snapshot(false);
   TrackerConfig config = config_;
   if (max_iterations > 0) config.ba_max_iterations = max_iterations;
   ScopedStageTimer timer(timings_, "ba_final");

@@ -58,6 +58,8 @@ class LocalBundleAdjuster {
   void loop();
   /// The current window of the map: every keyframe if `global`, else the newest ba_window.
   BaWindow snapshot(bool global) const;
+  /// The newest `keyframes` keyframes with the fixed ones the config asks for.
+  BaWindow windowOf(int keyframes) const;
   bool solve(BaWindow& window);        ///< timed as "ba" or "ba_global"; false = nothing solved
   bool nextRunIsGlobal();              ///< counts the request (requestRun(), under mutex_)
   void write(const BaWindow& solved);  ///< into the map; moved poses queue for takeUpdates()
