@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <cstdint>
 #include <cstring>
 
 #include <opencv2/core/utility.hpp>
@@ -13,136 +12,145 @@ namespace dynamap::conv {
 
 namespace {
 
-constexpr int kLanes = 8;  // OpenCV's fastConv sums 8 lanes (after folding 16 into 8)
+constexpr int kLanes = 8;         // floats in an AVX2 vector
+constexpr int kRowVectors = 4;    // depthwise: output vectors of a row summed side by side
+constexpr int kBlockPixels = 16;  // 1 x 1: pixels of a block (two vectors)
+constexpr int kBlockOutputs = 6;  // 1 x 1: output channels of a block (12 accumulators)
 
-/// Per output pixel, as OpenCV's generic path (im2row rows of k*k taps, zero padded to a
-/// multiple of 8, dotted with the weight row): tap t goes to lane t % 8 of an accumulator that
-/// starts at +0 and takes fma(w, x, acc) for each group of 8 taps (the padding taps add 0 * 0);
-/// the 8 lanes are summed as ((0+1)+(2+3))+((4+5)+(6+7)); then bias + sum, then leaky ReLU.
-/// Here the 8 lanes of a vector are 8 neighbouring output pixels.
+__attribute__((target("avx2,fma"))) inline __m256 activate(__m256 s, const Activation& a) {
+  if (!a.relu) return s;
+  const __m256 positive = _mm256_cmp_ps(s, _mm256_setzero_ps(), _CMP_GT_OS);
+  return _mm256_blendv_ps(_mm256_mul_ps(s, _mm256_set1_ps(a.slope)), s, positive);
+}
+
+/// Lanes [0, n) of a vector: a mask for maskload / maskstore.
+__attribute__((target("avx2,fma"))) inline __m256i firstLanes(int n) {
+  const __m256i index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  return _mm256_cmpgt_epi32(_mm256_set1_epi32(n), index);
+}
+
+/// Copies the plane into `padded` (zeros around it, rows wide enough for whole vectors).
+void padPlane(const DepthwisePlane& job, int k, int pad, int padded_width,
+              std::vector<float>& padded) {
+  const int padded_height = job.out_height + k - 1;
+  padded.assign(static_cast<std::size_t>(padded_width) * padded_height, 0.f);
+  for (int y = 0; y < job.height; ++y) {
+    const int py = y + pad;
+    if (py < 0 || py >= padded_height) continue;
+    const int n = std::min(job.width, padded_width - pad);
+    std::memcpy(&padded[static_cast<std::size_t>(py) * padded_width + pad],
+                job.in + static_cast<std::ptrdiff_t>(y) * job.width, sizeof(float) * n);
+  }
+}
+
+/// V neighbouring output vectors of row `oy` from x = ox: bias + the K x K taps, one
+/// accumulator per vector (independent chains keep the FMA units busy).
+template <int K, int V>
+__attribute__((target("avx2,fma"))) void depthwiseVectors(const DepthwisePlane& job,
+                                                          const float* padded, int padded_width,
+                                                          int oy, int ox, const __m256* w,
+                                                          const Activation& activation) {
+  __m256 acc[V];
+  for (int v = 0; v < V; ++v) acc[v] = _mm256_set1_ps(job.bias);
+  for (int ky = 0; ky < K; ++ky) {
+    const float* row = padded + static_cast<std::ptrdiff_t>(oy + ky) * padded_width + ox;
+    for (int kx = 0; kx < K; ++kx) {
+      for (int v = 0; v < V; ++v) {
+        acc[v] = _mm256_fmadd_ps(w[ky * K + kx], _mm256_loadu_ps(row + v * kLanes + kx), acc[v]);
+      }
+    }
+  }
+  float* dst = job.out + static_cast<std::ptrdiff_t>(oy) * job.out_width + ox;
+  for (int v = 0; v < V; ++v) {
+    const __m256 s = activate(acc[v], activation);
+    const int left = job.out_width - ox - v * kLanes;
+    if (left >= kLanes) {
+      _mm256_storeu_ps(dst + v * kLanes, s);
+    } else {
+      _mm256_maskstore_ps(dst + v * kLanes, firstLanes(left), s);
+    }
+  }
+}
+
 template <int K>
 __attribute__((target("avx2,fma"))) void depthwiseK(const DepthwisePlane& job, int pad,
                                                     const Activation& activation,
                                                     std::vector<float>& padded) {
-  constexpr int taps = K * K, groups = (taps + kLanes - 1) / kLanes;
-  const int vec_width = (job.out_width + kLanes - 1) / kLanes * kLanes;
-  const int pw = vec_width + K - 1, ph = job.out_height + K - 1;
-  padded.assign(static_cast<std::size_t>(pw) * ph, 0.f);
-  for (int y = 0; y < job.height; ++y) {
-    const int py = y + pad;
-    if (py < 0 || py >= ph) continue;
-    const int n = std::min(job.width, pw - pad);
-    std::memcpy(&padded[static_cast<std::size_t>(py) * pw + pad],
-                job.in + static_cast<std::ptrdiff_t>(y) * job.width, sizeof(float) * n);
-  }
-  const __m256 zero = _mm256_setzero_ps(), bias = _mm256_set1_ps(job.bias);
-  const __m256 slope = _mm256_set1_ps(activation.slope);
-  __m256 w[groups * kLanes];
-  for (int t = 0; t < groups * kLanes; ++t) w[t] = t < taps ? _mm256_set1_ps(job.weights[t]) : zero;
-  alignas(32) float tail[kLanes];
+  const int vectors = (job.out_width + kLanes - 1) / kLanes;
+  const int padded_width = vectors * kLanes + K - 1;
+  padPlane(job, K, pad, padded_width, padded);
+  __m256 w[K * K];
+  for (int t = 0; t < K * K; ++t) w[t] = _mm256_set1_ps(job.weights[t]);
   for (int oy = 0; oy < job.out_height; ++oy) {
-    for (int ox = 0; ox < vec_width; ox += kLanes) {
-      __m256 acc[kLanes];
-#pragma GCC unroll 64
-      for (int t = 0; t < groups * kLanes; ++t) {
-        const __m256 x =
-            t < taps
-                ? _mm256_loadu_ps(&padded[static_cast<std::size_t>(oy + t / K) * pw + ox + t % K])
-                : zero;
-        acc[t % kLanes] = _mm256_fmadd_ps(w[t], x, t < kLanes ? zero : acc[t % kLanes]);
-      }
-      const __m256 low =
-          _mm256_add_ps(_mm256_add_ps(acc[0], acc[1]), _mm256_add_ps(acc[2], acc[3]));
-      const __m256 high =
-          _mm256_add_ps(_mm256_add_ps(acc[4], acc[5]), _mm256_add_ps(acc[6], acc[7]));
-      __m256 s = _mm256_add_ps(bias, _mm256_add_ps(low, high));
-      if (activation.relu) {
-        const __m256 positive = _mm256_cmp_ps(s, zero, _CMP_GT_OS);
-        s = _mm256_blendv_ps(_mm256_mul_ps(s, slope), s, positive);
-      }
-      float* dst = job.out + static_cast<std::ptrdiff_t>(oy) * job.out_width + ox;
-      if (ox + kLanes <= job.out_width) {
-        _mm256_storeu_ps(dst, s);
-      } else {
-        _mm256_store_ps(tail, s);
-        std::memcpy(dst, tail, sizeof(float) * (job.out_width - ox));
-      }
+    int v = 0;
+    for (; v + kRowVectors <= vectors; v += kRowVectors) {
+      depthwiseVectors<K, kRowVectors>(job, padded.data(), padded_width, oy, v * kLanes, w,
+                                       activation);
+    }
+    for (; v < vectors; ++v) {
+      depthwiseVectors<K, 1>(job, padded.data(), padded_width, oy, v * kLanes, w, activation);
     }
   }
 }
 
-/// OpenCV's AVX-512 fastConv, per output: with >= 32 input channels, 16 lanes (channel c in
-/// lane c % 16, from +0) while 16 channels remain, folded to 8 as lane l + lane l + 8; the rest
-/// (or everything, under 32 channels) in 8 lanes, zero padded to a multiple of 8; then the
-/// depthwise case's pairwise sum, bias and ReLU. Here the 16 lanes of a vector are 16 pixels.
-__attribute__((target("avx512f,avx2,fma"))) void pointwiseAvx512(const Pointwise& job,
-                                                                 int out_begin, int out_end,
-                                                                 const Activation& activation) {
-  const int cin = job.in_channels, pixels = job.pixels;
-  const int wide = cin >= 32 ? cin / 16 : 0;  // OpenCV: k += 16 while k <= cin - 16
-  const int narrow_end = (cin + kLanes - 1) / kLanes * kLanes;
-  const __m512 zero = _mm512_setzero_ps(), slope = _mm512_set1_ps(activation.slope);
-  // The 16 pixels of every input channel are copied together first: read straight from the
-  // planes (a plane apart, often a multiple of 4 KiB) they evict each other from the L1 cache.
-  std::vector<float> block(static_cast<std::size_t>(cin) * 16 + 16);
-  float* x = reinterpret_cast<float*>((reinterpret_cast<std::uintptr_t>(block.data()) + 63) &
-                                      ~std::uintptr_t{63});
-  const std::ptrdiff_t stride = 16;
-  for (int p = 0; p < pixels; p += 16) {
-    const __mmask16 mask =
-        pixels - p >= 16 ? __mmask16(0xFFFF) : static_cast<__mmask16>((1u << (pixels - p)) - 1);
-    for (int c = 0; c < cin; ++c) {
-      _mm512_store_ps(x + c * stride,
-                      _mm512_maskz_loadu_ps(mask, job.in + std::ptrdiff_t{c} * pixels + p));
+/// R output channels from `o` of a block of 16 pixels from `p`: bias + the sum over input
+/// channels, two vectors per output. `block` holds the block's pixels of every input channel
+/// side by side (16 floats each); `tail` < 16 pixels are written masked.
+template <int R>
+__attribute__((target("avx2,fma"))) void pointwiseBlock(const Pointwise& job, const float* block,
+                                                        int o, int p, int tail,
+                                                        const Activation& activation) {
+  const int cin = job.in_channels;
+  __m256 acc0[R], acc1[R];  // pixels 0-7 and 8-15 (two arrays: GCC keeps them in registers)
+#pragma GCC unroll 8
+  for (int r = 0; r < R; ++r) acc0[r] = acc1[r] = _mm256_set1_ps(job.bias[o + r]);
+  const float* w = job.weights + static_cast<std::ptrdiff_t>(o) * cin;  // packed: R per channel
+  for (int c = 0; c < cin; ++c, w += R) {
+    const __m256 x0 = _mm256_loadu_ps(block + c * kBlockPixels);
+    const __m256 x1 = _mm256_loadu_ps(block + c * kBlockPixels + kLanes);
+#pragma GCC unroll 8
+    for (int r = 0; r < R; ++r) {
+      const __m256 wr = _mm256_broadcast_ss(w + r);
+      acc0[r] = _mm256_fmadd_ps(wr, x0, acc0[r]);
+      acc1[r] = _mm256_fmadd_ps(wr, x1, acc1[r]);
     }
-    for (int o = out_begin; o < out_end; ++o) {
-      const float* w = job.weights + static_cast<std::ptrdiff_t>(o) * cin;
-      __m512 b[kLanes];
-      if (wide > 0) {
-        __m512 a[16];
-        for (int l = 0; l < 16; ++l) {
-          a[l] = _mm512_fmadd_ps(_mm512_set1_ps(w[l]), _mm512_load_ps(x + l * stride), zero);
-        }
-        for (int j = 1; j < wide; ++j) {
-          for (int l = 0; l < 16; ++l) {
-            const int c = 16 * j + l;
-            a[l] = _mm512_fmadd_ps(_mm512_set1_ps(w[c]), _mm512_load_ps(x + c * stride), a[l]);
-          }
-        }
-        for (int l = 0; l < kLanes; ++l) b[l] = _mm512_add_ps(a[l], a[l + kLanes]);
-      } else {
-        for (int l = 0; l < kLanes; ++l) b[l] = zero;
-      }
-      for (int c0 = 16 * wide; c0 < narrow_end; c0 += kLanes) {
-        for (int l = 0; l < kLanes; ++l) {
-          const int c = c0 + l;
-          b[l] = c < cin
-                     ? _mm512_fmadd_ps(_mm512_set1_ps(w[c]), _mm512_load_ps(x + c * stride), b[l])
-                     : _mm512_fmadd_ps(zero, zero, b[l]);
-        }
-      }
-      const __m512 low = _mm512_add_ps(_mm512_add_ps(b[0], b[1]), _mm512_add_ps(b[2], b[3]));
-      const __m512 high = _mm512_add_ps(_mm512_add_ps(b[4], b[5]), _mm512_add_ps(b[6], b[7]));
-      __m512 s = _mm512_add_ps(_mm512_set1_ps(job.bias[o]), _mm512_add_ps(low, high));
-      if (activation.relu) {
-        const __mmask16 positive = _mm512_cmp_ps_mask(s, zero, _CMP_GT_OS);
-        s = _mm512_mask_blend_ps(positive, _mm512_mul_ps(s, slope), s);
-      }
-      _mm512_mask_storeu_ps(job.out + static_cast<std::ptrdiff_t>(o) * pixels + p, mask, s);
+  }
+  const __m256i mask0 = firstLanes(tail), mask1 = firstLanes(tail - kLanes);
+#pragma GCC unroll 8
+  for (int r = 0; r < R; ++r) {
+    float* dst = job.out + static_cast<std::ptrdiff_t>(o + r) * job.pixels + p;
+    const __m256 s0 = activate(acc0[r], activation), s1 = activate(acc1[r], activation);
+    if (tail >= kBlockPixels) {
+      _mm256_storeu_ps(dst, s0);
+      _mm256_storeu_ps(dst + kLanes, s1);
+    } else {
+      _mm256_maskstore_ps(dst, mask0, s0);
+      _mm256_maskstore_ps(dst + kLanes, mask1, s1);
     }
   }
 }
+
+/// The block's pixels of every input channel side by side: read straight from the planes (a
+/// plane apart, often a multiple of 4 KiB) they would evict each other from the L1 cache.
+void gatherBlock(const Pointwise& job, int p, int tail, std::vector<float>& block) {
+  block.assign(static_cast<std::size_t>(job.in_channels) * kBlockPixels, 0.f);
+  for (int c = 0; c < job.in_channels; ++c) {
+    std::memcpy(&block[static_cast<std::size_t>(c) * kBlockPixels],
+                job.in + static_cast<std::ptrdiff_t>(c) * job.pixels + p, sizeof(float) * tail);
+  }
+}
+
+using PointwiseBlockFn = void (*)(const Pointwise&, const float*, int, int, int,
+                                  const Activation&);
+constexpr PointwiseBlockFn kPointwiseBlocks[kBlockOutputs + 1] = {
+    nullptr,           pointwiseBlock<1>, pointwiseBlock<2>, pointwiseBlock<3>,
+    pointwiseBlock<4>, pointwiseBlock<5>, pointwiseBlock<6>};
 
 }  // namespace
 
 bool cpuHasAvx2Fma() {
   static const bool has =
       cv::checkHardwareSupport(CV_CPU_AVX2) && cv::checkHardwareSupport(CV_CPU_FMA3);
-  return has;
-}
-
-bool cpuHasAvx512() {
-  static const bool has = cpuHasAvx2Fma() && cv::checkHardwareSupport(CV_CPU_AVX512_SKX);
   return has;
 }
 
@@ -155,8 +163,30 @@ void depthwise(const DepthwisePlane& job, int k, int pad, const Activation& acti
   }
 }
 
-void pointwise(const Pointwise& job, int out_begin, int out_end, const Activation& activation) {
-  pointwiseAvx512(job, out_begin, out_end, activation);
+void packPointwiseWeights(const float* weights, int out_channels, int in_channels,
+                          std::vector<float>& packed) {
+  packed.resize(static_cast<std::size_t>(out_channels) * in_channels);
+  float* dst = packed.data();
+  for (int o = 0; o < out_channels; o += kBlockOutputs) {
+    const int rows = std::min(kBlockOutputs, out_channels - o);
+    for (int c = 0; c < in_channels; ++c) {
+      for (int r = 0; r < rows; ++r) *dst++ = weights[static_cast<std::ptrdiff_t>(o + r) * in_channels + c];
+    }
+  }
+}
+
+int pointwiseBlocks(int pixels) { return (pixels + kBlockPixels - 1) / kBlockPixels; }
+
+void pointwise(const Pointwise& job, int block_begin, int block_end, const Activation& activation,
+               std::vector<float>& block) {
+  for (int b = block_begin; b < block_end; ++b) {
+    const int p = b * kBlockPixels, tail = std::min(kBlockPixels, job.pixels - p);
+    gatherBlock(job, p, tail, block);
+    for (int o = 0; o < job.out_channels; o += kBlockOutputs) {
+      const int rows = std::min(kBlockOutputs, job.out_channels - o);
+      kPointwiseBlocks[rows](job, block.data(), o, p, tail, activation);
+    }
+  }
 }
 
 }  // namespace dynamap::conv

@@ -17,10 +17,6 @@ using cv::dnn::BaseConvolutionLayer;
 using cv::dnn::Layer;
 using cv::dnn::MatShape;
 
-constexpr int kOpenCvFast = 16;   // OpenCV's depthwise kernel needs width >= 16 + dilation*(k-1)
-constexpr int kOpenCvBlock = 32;  // outputs per block of OpenCV's generic path (BLK_SIZE)
-constexpr int kOpenCvChannelBlock = 512;  // 1 x 1: input channels per pass (blk_size_cn)
-
 enum class OwnKernel { kNone, kDepthwise, kPointwise };
 
 struct Plan {
@@ -28,20 +24,6 @@ struct Plan {
   int k = 0, pad = 0;
   conv::Activation activation;
 };
-
-/// OpenCV's generic path splits each group's output plane into stripes (one per plane unless
-/// threads outnumber planes) and each stripe into blocks of 32 outputs; a last block of 1-3
-/// outputs takes a scalar loop that sums in another order. Those layouts are left to OpenCV.
-bool openCvSumsInBlocks(int planes, int plane_size) {
-  const int nstripes = std::max(cv::getNumThreads(), 1);
-  const int per_plane = nstripes >= planes * 2 ? nstripes / planes : 1;
-  const int stripe = std::min(((plane_size + per_plane - 1) / per_plane + 7) / 8 * 8, plane_size);
-  for (int start = 0; start < plane_size; start += stripe) {
-    const int tail = (std::min(start + stripe, plane_size) - start) % kOpenCvBlock;
-    if (tail > 0 && tail < 4) return false;
-  }
-  return true;
-}
 
 /// Wraps OpenCV's convolution layer: the wrapped layer is finalised and fused exactly as it
 /// would be alone (and runs every case this one does not), while this one keeps its own copy of
@@ -65,6 +47,7 @@ class OwnConvLayer : public Layer {
     inner_->finalize(inputs, outputs);
     const int out_cn = blobs[0].size[0];
     weights_ = blobs[0].reshape(1, out_cn).clone();
+    packed_weights_.clear();
     multipliers_.assign(out_cn, 1.0);
     bias_.assign(out_cn, 0.f);
     if (blobs.size() >= 2) {
@@ -105,13 +88,18 @@ class OwnConvLayer : public Layer {
     const cv::Mat& in = inputs[0];
     cv::Mat& out = outputs[0];
     if (plan.kernel == OwnKernel::kPointwise) {
-      const int out_cn = out.size[1];
+      const int pixels = in.size[2] * in.size[3];
+      if (packed_weights_.empty()) {
+        conv::packPointwiseWeights(weights_.ptr<float>(), out.size[1], in.size[1],
+                                   packed_weights_);
+      }
       for (int n = 0; n < in.size[0]; ++n) {
-        const conv::Pointwise job{in.ptr<float>(n),        in.size[1],
-                                  in.size[2] * in.size[3], out.ptr<float>(n),
-                                  weights_.ptr<float>(),   bias_.data()};
-        cv::parallel_for_(cv::Range(0, out_cn), [&](const cv::Range& r) {
-          conv::pointwise(job, r.start, r.end, plan.activation);
+        const conv::Pointwise job{in.ptr<float>(n),  in.size[1],           pixels,
+                                  out.ptr<float>(n), out.size[1],          packed_weights_.data(),
+                                  bias_.data()};
+        cv::parallel_for_(cv::Range(0, conv::pointwiseBlocks(pixels)), [&](const cv::Range& r) {
+          std::vector<float> block;
+          conv::pointwise(job, r.start, r.end, plan.activation, block);
         });
       }
       return;
@@ -150,6 +138,7 @@ class OwnConvLayer : public Layer {
  private:
   // As OpenCV's ConvolutionLayerImpl::fuseWeights: (conv(I) + b1) * w + b2.
   void fuseWeights(const cv::Mat& w_in, const cv::Mat& b_in) {
+    packed_weights_.clear();
     const int out_cn = weights_.rows;
     const cv::Mat w =
         w_in.total() == 1 ? cv::Mat(1, out_cn, CV_32F, cv::Scalar(w_in.at<float>(0))) : w_in;
@@ -170,8 +159,7 @@ class OwnConvLayer : public Layer {
     }
   }
 
-  // The cases OpenCV 4.6 runs through its generic path with a layout the kernels follow (see
-  // the header and conv_kernels.hpp), no activation or a (leaky) ReLU.
+  // Stride-1 depthwise 3 x 3 and 5 x 5 and 1 x 1 convolutions, no activation or a (leaky) ReLU.
   Plan ownPlan(const std::vector<cv::Mat>& inputs, const std::vector<cv::Mat>& outputs) const {
     if (!conv::cpuHasAvx2Fma() || inputs.size() != 1 || outputs.size() != 1 || blobs.empty() ||
         blobs[0].dims != 4) {
@@ -198,14 +186,10 @@ class OwnConvLayer : public Layer {
         out.size[3] != in.size[3] + 2 * pad - k + 1) {
       return {};
     }
-    const int cin = in.size[1], plane = out.size[2] * out.size[3];
+    const int cin = in.size[1];
     if (blobs[0].size[1] == 1 && cin == out.size[1] && (k == 3 || k == 5)) {
-      const bool opencv_fast = k == 3 && in.size[3] >= kOpenCvFast + (k - 1) && pad <= 1;
-      if (opencv_fast || !openCvSumsInBlocks(in.size[0] * cin, plane)) return {};
       plan.kernel = OwnKernel::kDepthwise;
-    } else if (k == 1 && pad == 0 && blobs[0].size[1] == cin && cin <= kOpenCvChannelBlock &&
-               conv::cpuHasAvx512()) {
-      if (!openCvSumsInBlocks(in.size[0], plane)) return {};
+    } else if (k == 1 && pad == 0 && blobs[0].size[1] == cin) {
       plan.kernel = OwnKernel::kPointwise;
     } else {
       return {};
@@ -221,6 +205,7 @@ class OwnConvLayer : public Layer {
   cv::Mat weights_;                  // fused, out_cn x in_cn*k*k
   std::vector<double> multipliers_;  // as OpenCV's weightsMultipliers
   std::vector<float> bias_;
+  std::vector<float> packed_weights_;  // 1 x 1: weights_ as the kernel reads them (1st forward)
 };
 
 std::mutex& registryMutex() {
