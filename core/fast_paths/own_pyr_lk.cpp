@@ -13,7 +13,9 @@
 namespace dynamap::lk {
 namespace {
 
-constexpr int kWidth = 15;  // the window width written here: two vectors of 8 pixels, 1 unused
+constexpr int kWidth = 15;  // the window width written here: 8 pixels in lanes, 7 one by one
+constexpr int kLanePixels = 8;
+constexpr int kTailPixels = kWidth - kLanePixels;
 constexpr int kWBits = 14;                    // OpenCV's fixed-point bilinear weights
 constexpr float kFltScale = 1.f / (1 << 20);  // its scale of the sums
 constexpr float kMinEigThreshold = 1e-4f;     // its default threshold, as float
@@ -97,29 +99,17 @@ inline const std::uint8_t* rowOf(const cv::Mat& image, int y) {
   return image.data + static_cast<std::ptrdiff_t>(y) * static_cast<std::ptrdiff_t>(image.step[0]);
 }
 
-/// Sum of the 8 lanes.
-__attribute__((target("avx2"))) inline float laneSum(__m256 v) {
-  const __m128 q = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-  const __m128 h = _mm_add_ps(q, _mm_movehl_ps(q, q));
-  return _mm_cvtss_f32(_mm_add_ss(h, _mm_movehdup_ps(h)));
-}
-
-/// a * b of int32 lanes, as float.
-__attribute__((target("avx2"))) inline __m256 productPs(__m256i a, __m256i b) {
-  return _mm256_cvtepi32_ps(_mm256_mullo_epi32(a, b));
-}
-
 /// Reads the first image's window at (x0, y0) (its top-left pixel) with weights w and returns
-/// OpenCV's A11, A12, A22 sums (before scaling). Pixel 15 (outside the window) gets zero
-/// derivatives, so it adds nothing here or in mismatch().
+/// OpenCV's A11, A12, A22 sums (before scaling).
 __attribute__((target("avx2"))) void readWindow(const cv::Mat& image, const cv::Mat& deriv, int x0,
                                                 int y0, const Weights& weights, Window& win,
                                                 float& a11, float& a12, float& a22) {
   const Pair w = pairOf(weights);
   const auto rows = static_cast<int>(win.size());
+  __m128 q11 = _mm_setzero_ps(), q12 = _mm_setzero_ps(), q22 = _mm_setzero_ps();
+  float s11 = 0.f, s12 = 0.f, s22 = 0.f;
+  alignas(32) float t11[8], t12[8], t22[8];
   const __m256i zero = _mm256_setzero_si256();
-  const __m256i window_lanes = _mm256_setr_epi32(-1, -1, -1, -1, -1, -1, -1, 0);  // pixels 8..14
-  __m256 s11 = _mm256_setzero_ps(), s12 = _mm256_setzero_ps(), s22 = _mm256_setzero_ps();
   for (int y = 0; y < rows; ++y) {
     const std::uint8_t* src = rowOf(image, y0 + y) + x0;
     win[y].value = bilinearU8(src, src + image.step[0], w);
@@ -132,18 +122,38 @@ __attribute__((target("avx2"))) void readWindow(const cv::Mat& image, const cv::
     const __m256i d0 =
         bilinear<kWBits>(a0, nextPixel(a0, a1), c0, nextPixel(c0, c1), w);  // Ix0 Iy0 ..
     const __m256i d1 = bilinear<kWBits>(a1, nextPixel(a1, zero), c1, nextPixel(c1, zero), w);
-    WindowRow& row = win[y];
-    row.dx0 = lowShort(d0);
-    row.dy0 = _mm256_srai_epi32(d0, 16);
-    row.dx1 = _mm256_and_si256(lowShort(d1), window_lanes);
-    row.dy1 = _mm256_and_si256(_mm256_srai_epi32(d1, 16), window_lanes);
-    s11 = _mm256_add_ps(s11, _mm256_add_ps(productPs(row.dx0, row.dx0), productPs(row.dx1, row.dx1)));
-    s12 = _mm256_add_ps(s12, _mm256_add_ps(productPs(row.dx0, row.dy0), productPs(row.dx1, row.dy1)));
-    s22 = _mm256_add_ps(s22, _mm256_add_ps(productPs(row.dy0, row.dy0), productPs(row.dy1, row.dy1)));
+    win[y].dx0 = lowShort(d0);
+    win[y].dy0 = _mm256_srai_epi32(d0, 16);
+    win[y].dx1 = lowShort(d1);
+    win[y].dy1 = _mm256_srai_epi32(d1, 16);
+    // Pixels 0..7: four lanes, pixels 0..3 then 4..7, each a product then a sum.
+    const __m256 fx = _mm256_cvtepi32_ps(win[y].dx0), fy = _mm256_cvtepi32_ps(win[y].dy0);
+    const __m256 m22 = _mm256_mul_ps(fy, fy), m12 = _mm256_mul_ps(fx, fy),
+                 m11 = _mm256_mul_ps(fx, fx);
+    q22 = _mm_add_ps(q22, _mm256_castps256_ps128(m22));
+    q12 = _mm_add_ps(q12, _mm256_castps256_ps128(m12));
+    q11 = _mm_add_ps(q11, _mm256_castps256_ps128(m11));
+    q22 = _mm_add_ps(q22, _mm256_extractf128_ps(m22, 1));
+    q12 = _mm_add_ps(q12, _mm256_extractf128_ps(m12, 1));
+    q11 = _mm_add_ps(q11, _mm256_extractf128_ps(m11, 1));
+    // Pixels 8..14: integer products as float, summed one by one.
+    _mm256_store_ps(t11, _mm256_cvtepi32_ps(_mm256_mullo_epi32(win[y].dx1, win[y].dx1)));
+    _mm256_store_ps(t12, _mm256_cvtepi32_ps(_mm256_mullo_epi32(win[y].dx1, win[y].dy1)));
+    _mm256_store_ps(t22, _mm256_cvtepi32_ps(_mm256_mullo_epi32(win[y].dy1, win[y].dy1)));
+    for (int k = 0; k < kTailPixels; ++k) {
+      s11 += t11[k];
+      s12 += t12[k];
+      s22 += t22[k];
+    }
   }
-  a11 = laneSum(s11);
-  a12 = laneSum(s12);
-  a22 = laneSum(s22);
+  const auto reduce = [](__m128 q) {  // OpenCV's v_reduce_sum: (0 + 2) + (1 + 3)
+    alignas(16) float v[4];
+    _mm_store_ps(v, q);
+    return (v[0] + v[2]) + (v[1] + v[3]);
+  };
+  a11 = s11 + reduce(q11);
+  a12 = s12 + reduce(q12);
+  a22 = s22 + reduce(q22);
 }
 
 /// OpenCV's b1, b2 sums (before scaling) of the window against the second image at (x0, y0).
@@ -152,17 +162,34 @@ __attribute__((target("avx2"))) void mismatch(const cv::Mat& image, int x0, int 
                                               float& b2) {
   const Pair w = pairOf(weights);
   const auto rows = static_cast<int>(win.size());
-  __m256 sx = _mm256_setzero_ps(), sy = _mm256_setzero_ps();
+  __m256 qb = _mm256_setzero_ps();  // OpenCV's qb0 | qb1
+  float s1 = 0.f, s2 = 0.f;
+  alignas(32) float t1[8], t2[8];
   for (int y = 0; y < rows; ++y) {
     const std::uint8_t* src = rowOf(image, y0 + y) + x0;
     const __m256i diff = _mm256_subs_epi16(bilinearU8(src, src + image.step[0], w), win[y].value);
     const __m256i it0 = _mm256_cvtepi16_epi32(_mm256_castsi256_si128(diff));
     const __m256i it1 = _mm256_cvtepi16_epi32(_mm256_extracti128_si256(diff, 1));
-    sx = _mm256_add_ps(sx, _mm256_add_ps(productPs(it0, win[y].dx0), productPs(it1, win[y].dx1)));
-    sy = _mm256_add_ps(sy, _mm256_add_ps(productPs(it0, win[y].dy0), productPs(it1, win[y].dy1)));
+    // Pixels 0..7: OpenCV's lanes hold pixel pairs (0, 4), (1, 5) in qb0, (2, 6), (3, 7) in qb1.
+    const __m256i px = _mm256_mullo_epi32(it0, win[y].dx0);
+    const __m256i py = _mm256_mullo_epi32(it0, win[y].dy0);
+    const __m128i sx = _mm_add_epi32(_mm256_castsi256_si128(px), _mm256_extracti128_si256(px, 1));
+    const __m128i sy = _mm_add_epi32(_mm256_castsi256_si128(py), _mm256_extracti128_si256(py, 1));
+    const __m256i terms = _mm256_set_m128i(_mm_unpackhi_epi32(sx, sy), _mm_unpacklo_epi32(sx, sy));
+    qb = _mm256_add_ps(qb, _mm256_cvtepi32_ps(terms));
+    // Pixels 8..14, one by one.
+    _mm256_store_ps(t1, _mm256_cvtepi32_ps(_mm256_mullo_epi32(it1, win[y].dx1)));
+    _mm256_store_ps(t2, _mm256_cvtepi32_ps(_mm256_mullo_epi32(it1, win[y].dy1)));
+    for (int k = 0; k < kTailPixels; ++k) {
+      s1 += t1[k];
+      s2 += t2[k];
+    }
   }
-  b1 = laneSum(sx);
-  b2 = laneSum(sy);
+  alignas(16) float q[4];
+  _mm_store_ps(q, _mm_add_ps(_mm256_castps256_ps128(qb), _mm256_extractf128_ps(qb, 1)));
+  // OpenCV interleaves the lanes to (x, x, y, y) sums and reduces each half with zeros.
+  b1 = s1 + ((q[0] + 0.f) + (q[2] + 0.f));
+  b2 = s2 + ((q[1] + 0.f) + (q[3] + 0.f));
 }
 
 /// One level for one point, as OpenCV's LKTrackerInvoker.

@@ -24,10 +24,10 @@ struct Outcome {
 };
 
 /// Both LKs from the same start; the share of points on which they agree: the same status and,
-/// where both tracked the point, end positions within `tolerance_px`.
+/// where both tracked the point, end positions within 0.01 px.
 double agreement(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& next,
                  const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& guess,
-                 int max_level, int iterations, double tolerance_px = 0.01) {
+                 int max_level, int iterations) {
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, iterations,
                                   0.01);
   Outcome cv_out{guess, {}}, own{guess, {}};
@@ -37,18 +37,13 @@ double agreement(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& n
   std::size_t agree = 0;
   for (std::size_t i = 0; i < from.size(); ++i) {
     const bool cv_ok = cv_out.status[i] != 0, own_ok = own.status[i] != 0;
-    agree += cv_ok == own_ok && (!cv_ok || cv::norm(cv_out.px[i] - own.px[i]) <= tolerance_px);
+    agree += cv_ok == own_ok && (!cv_ok || cv::norm(cv_out.px[i] - own.px[i]) <= 0.01);
   }
   return static_cast<double>(agree) / static_cast<double>(from.size());
 }
 
 /// The tolerance: 99.9 % of the points agree (float rounding may send an odd point elsewhere).
 constexpr double kMinAgreement = 0.999;
-/// On real frames the sums' other order moves an iteration's stop: 99 % of the features agree
-/// within 0.1 px (measured: 99 % within 0.075 px). Points in flat areas or off the image are
-/// ill-conditioned there and may end anywhere with either LK; only features are compared.
-constexpr double kMinFeatureAgreement = 0.99;
-constexpr double kFeatureTolerancePx = 0.1;
 
 std::vector<cv::Mat> pyramidOf(const cv::Mat& gray, int max_level) {
   std::vector<cv::Mat> pyramid;
@@ -118,15 +113,10 @@ TEST(OwnPyrLk, AgreesWithOpenCvOnRealFrames) {
       cv::cvtColor(cv::imread(frames[i].string()), a, cv::COLOR_BGR2GRAY);
       cv::cvtColor(cv::imread(frames[i + 3].string()), b, cv::COLOR_BGR2GRAY);
       const auto prev = pyramidOf(a, 5), next = pyramidOf(b, 5);
-      std::vector<cv::Point2f> from;
-      cv::goodFeaturesToTrack(a, from, 400, 0.01, 8);
-      ASSERT_GE(from.size(), 200u) << frames[i];
-      EXPECT_GE(agreement(prev, next, from, guesses(from, rng, 4.f), 5, 20, kFeatureTolerancePx),
-                kMinFeatureAgreement)
+      const std::vector<cv::Point2f> from = testPoints(a, rng);
+      EXPECT_GE(agreement(prev, next, from, guesses(from, rng, 4.f), 5, 20), kMinAgreement)
           << frames[i] << " forward";
-      EXPECT_GE(agreement(next, prev, from, from, 2, 20, kFeatureTolerancePx),
-                kMinFeatureAgreement)
-          << frames[i] << " backward";
+      EXPECT_GE(agreement(next, prev, from, from, 2, 20), kMinAgreement) << frames[i] << " backward";
     }
   }
 }

@@ -15,10 +15,8 @@ bool ownPyrLkUsable(cv::Size window);
 /// max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW) for pyramids that
 /// cv::buildOpticalFlowPyramid built with derivatives (minimum eigenvalue threshold 1e-4): the
 /// same algorithm (OpenCV's fixed-point bilinear windows, its update and stopping rules), with
-/// the work of a window done for whole rows at once in AVX2 and summed in vectors of 8 pixels
-/// (another order than OpenCV's). Tracks of features agree with OpenCV's within 0.1 px (99 %;
-/// a shifted texture: 99.9 % within 0.01 px; tests/fast_paths). Check ownPyrLkUsable(window)
-/// first.
+/// the integer work of a window done for whole rows at once in AVX2. Tracks agree with
+/// OpenCV's within 0.01 px (tests/fast_paths). Check ownPyrLkUsable(window) first.
 void ownPyrLk(const std::vector<cv::Mat>& prev, const std::vector<cv::Mat>& next,
               const std::vector<cv::Point2f>& prev_px, std::vector<cv::Point2f>& next_px,
               std::vector<std::uint8_t>& status, cv::Size window, int max_level,
