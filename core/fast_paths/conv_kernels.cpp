@@ -132,16 +132,18 @@ __attribute__((target("avx2,fma"))) void pointwiseBlock(const Pointwise& job, co
 
 /// The block's pixels of every input channel side by side: read straight from the planes (a
 /// plane apart, often a multiple of 4 KiB) they would evict each other from the L1 cache.
+/// A partial last block's missing pixels are zeros.
 void gatherBlock(const Pointwise& job, int p, int tail, std::vector<float>& block) {
-  block.assign(static_cast<std::size_t>(job.in_channels) * kBlockPixels, 0.f);
+  block.resize(static_cast<std::size_t>(job.in_channels) * kBlockPixels);
   for (int c = 0; c < job.in_channels; ++c) {
-    std::memcpy(&block[static_cast<std::size_t>(c) * kBlockPixels],
-                job.in + static_cast<std::ptrdiff_t>(c) * job.pixels + p, sizeof(float) * tail);
+    float* dst = &block[static_cast<std::size_t>(c) * kBlockPixels];
+    std::memcpy(dst, job.in + static_cast<std::ptrdiff_t>(c) * job.pixels + p,
+                sizeof(float) * tail);
+    std::fill(dst + tail, dst + kBlockPixels, 0.f);
   }
 }
 
-using PointwiseBlockFn = void (*)(const Pointwise&, const float*, int, int, int,
-                                  const Activation&);
+using PointwiseBlockFn = void (*)(const Pointwise&, const float*, int, int, int, const Activation&);
 constexpr PointwiseBlockFn kPointwiseBlocks[kBlockOutputs + 1] = {
     nullptr,           pointwiseBlock<1>, pointwiseBlock<2>, pointwiseBlock<3>,
     pointwiseBlock<4>, pointwiseBlock<5>, pointwiseBlock<6>};
@@ -170,7 +172,8 @@ void packPointwiseWeights(const float* weights, int out_channels, int in_channel
   for (int o = 0; o < out_channels; o += kBlockOutputs) {
     const int rows = std::min(kBlockOutputs, out_channels - o);
     for (int c = 0; c < in_channels; ++c) {
-      for (int r = 0; r < rows; ++r) *dst++ = weights[static_cast<std::ptrdiff_t>(o + r) * in_channels + c];
+      for (int r = 0; r < rows; ++r)
+        *dst++ = weights[static_cast<std::ptrdiff_t>(o + r) * in_channels + c];
     }
   }
 }

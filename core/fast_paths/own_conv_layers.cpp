@@ -90,12 +90,11 @@ class OwnConvLayer : public Layer {
     if (plan.kernel == OwnKernel::kPointwise) {
       const int pixels = in.size[2] * in.size[3];
       if (packed_weights_.empty()) {
-        conv::packPointwiseWeights(weights_.ptr<float>(), out.size[1], in.size[1],
-                                   packed_weights_);
+        conv::packPointwiseWeights(weights_.ptr<float>(), out.size[1], in.size[1], packed_weights_);
       }
       for (int n = 0; n < in.size[0]; ++n) {
-        const conv::Pointwise job{in.ptr<float>(n),  in.size[1],           pixels,
-                                  out.ptr<float>(n), out.size[1],          packed_weights_.data(),
+        const conv::Pointwise job{in.ptr<float>(n),  in.size[1],  pixels,
+                                  out.ptr<float>(n), out.size[1], packed_weights_.data(),
                                   bias_.data()};
         cv::parallel_for_(cv::Range(0, conv::pointwiseBlocks(pixels)), [&](const cv::Range& r) {
           std::vector<float> block;
