@@ -58,6 +58,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
+  schema.addDouble("tracking.ba_covisible_min_age_s", &c.ba_covisible_min_age_s, 0.0, 1e9);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_fixed_covisible", &c.ba_fixed_covisible, 0, 1000);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);

@@ -130,7 +130,10 @@ void countQuietFrames(ObjectTrack& t, const ObjectDecision& d, const ObjectTrack
   int before = prev != nullptr ? prev->quiet_frames : 0;
   if (prev != nullptr && prev->has_anchor) t.has_anchor = true, t.anchor_W = prev->anchor_W;
   bool still = false;  // its world position stayed put (camera pose from proven landmarks)
-  t.anchors = d.anchor.kept;
+  // A frame without a pose checks no anchors: it keeps them. Dropped there, the teddy (taken for
+  // a person) of teddy x10 at a turn lost them in two frames without a pose, was judged on its
+  // centroid, which had drifted with the view, restarted its count and was masked.
+  t.anchors = d.anchor.checked || prev == nullptr ? d.anchor.kept : prev->anchors;
   if (obs.anchored()) {
     // Its own points, followed over time, tell better than its centroid.
     still = obs.anchors == AnchorVerdict::kStill;

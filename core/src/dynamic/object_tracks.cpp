@@ -18,6 +18,7 @@ AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
                          const std::vector<PointSample>& now, const cv::Matx44d& T_W_C,
                          const cv::Vec4d& K) {
   AnchorCheck out;
+  out.checked = true;
   const cv::Matx44d T_C_W = T_W_C.inv(cv::DECOMP_SVD);
   std::vector<double> dist, dz;
   for (const auto& s : now) {

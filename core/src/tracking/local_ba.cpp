@@ -114,7 +114,7 @@ void LocalBundleAdjuster::stop() {
 
 BaWindow LocalBundleAdjuster::windowOf(int keyframes) const {
   return map_.snapshotWindow(keyframes, config_.ba_fixed_keyframes, config_.ba_fixed_covisible,
-                             config_.kf_reuse_min_age_s);
+                             config_.ba_covisible_min_age_s);
 }
 
 BaWindow LocalBundleAdjuster::snapshot(bool global) const {

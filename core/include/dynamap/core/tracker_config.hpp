@@ -134,12 +134,15 @@ struct TrackerConfig {
   bool ba_lockstep = true;
   int ba_window = 8;           ///< keyframes optimised together
   int ba_fixed_keyframes = 1;  ///< oldest keyframes of the window held fixed (gauge)
-  /// Up to this many keyframes older than the window and kf_reuse_min_age_s older than its
+  /// Up to this many keyframes older than the window and ba_covisible_min_age_s older than its
   /// newest keyframe that see its landmarks (a revisit found them again) are held fixed in the
   /// local BA, so it keeps the old map's landmarks where the old keyframes put them. 0: only
   /// the window and the keyframes just before it (until session 64: nine long runs' mean ATE
   /// 1.34 cm, with 8 1.26 cm at the same kf_reuse_min_age_s; BENCHMARKS.md, "Long runs").
   int ba_fixed_covisible = 8;
+  /// ... made at least this long (s) before the window's newest keyframe: an earlier visit's
+  /// (until session 66 kf_reuse_min_age_s set both).
+  double ba_covisible_min_age_s = 5.0;
   int ba_max_iterations = 10;
   /// Every this many keyframes the BA thread optimises every keyframe instead of the newest
   /// ba_window (stage "ba_global"), and the final BA only what came since (0 = never). Off:

@@ -28,6 +28,7 @@ struct PointSample {
 /// noise over many frames; a person swaying 5 cm on the spot, or walking slowly, drifts out of it
 /// while every frame-to-frame check passes.
 struct AnchorCheck {
+  bool checked = false;    ///< made (a frame with a pose and point ids); else all below are empty
   int points = 0;          ///< anchored in an earlier frame and seen now (with depth)
   double median_px = 0.0;  ///< their median distance
   /// Signed median of (depth measured now - anchored point's depth in this camera): a person
