@@ -103,7 +103,9 @@ struct TrackerConfig {
   /// ba_fixed_covisible 8, nine long runs (BENCHMARKS.md, session 64): at 5 / 4 / 3 s 512 / 496
   /// / 482 keyframes, 3 / 3 / 7 lost frames; at 4 two of six teddy_dyn_crowd_dev starts kept a
   /// walker (ghost 0.06 -> 3.6 %); 3 s without ba_fixed_covisible lost teddy_dyn_dev x10 in
-  /// pass 6 (0.96 -> 2.08 cm).
+  /// pass 6 (0.96 -> 2.08 cm). Alone (ba_covisible_min_age_s at 5 s; twelve long runs, session
+  /// 66): at 3 s crowd x10 from frame 6 ran away (3.82 cm); at 2 s 703 keyframes for 736 and the
+  /// crowd's mask IoU .775 for .754, but teddy_dyn_dev 0.86-0.89 -> 0.93-1.00 cm, 2 lost frames.
   double kf_reuse_min_age_s = 5.0;
   /// The revisited keyframes' landmarks are searched for among this many ORB keypoints of the
   /// frame, detected down to this FAST threshold: the top 1000 at 12 held a keypoint near only a
