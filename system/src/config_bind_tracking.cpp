@@ -58,9 +58,9 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addBool("tracking.bundle_adjustment", &c.bundle_adjustment);
   schema.addBool("tracking.ba_lockstep", &c.ba_lockstep);
   schema.addInt("tracking.ba_window", &c.ba_window, 2, 100);
-  schema.addDouble("tracking.ba_covisible_min_age_s", &c.ba_covisible_min_age_s, 0.0, 1e9);
   schema.addInt("tracking.ba_fixed_keyframes", &c.ba_fixed_keyframes, 1, 99);
   schema.addInt("tracking.ba_fixed_covisible", &c.ba_fixed_covisible, 0, 1000);
+  schema.addDouble("tracking.ba_covisible_min_age_s", &c.ba_covisible_min_age_s, 0.0, 1e9);
   schema.addInt("tracking.ba_max_iterations", &c.ba_max_iterations, 1, 500);
   schema.addInt("tracking.ba_global_every_keyframes", &c.ba_global_every_keyframes, 0, 1000000);
   schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);
