@@ -65,26 +65,24 @@ TEST(LocalMap, IdsAreDenseAndKeyframeCountsFollowObservations) {
   EXPECT_FALSE(map.isBad(1000));
 }
 
-TEST(LocalMap, RelocCandidatesAreTheNewestKeyframesLandmarksOnceWithoutBadOrUndescribed) {
+TEST(LocalMap, NewestKeyframesLandmarksOnceWithoutBadOrUndescribed) {
   LocalMap map;
   buildMap(map);
-  std::vector<std::uint64_t> ids;
-  cv::Mat descriptors;
-  std::vector<Eigen::Vector3d> points;
-  map.relocCandidates(2, ids, descriptors, points);
+  EXPECT_EQ(map.newestKeyframes(2), (std::vector<std::uint64_t>{3, 2}));
+  LandmarkCandidates c = map.landmarksOf(map.newestKeyframes(2));
   // kf3 then kf2; 9 has no descriptor, 7 is listed once.
-  EXPECT_EQ(ids, (std::vector<std::uint64_t>{7, 8, 5, 6}));
-  ASSERT_EQ(descriptors.rows, 4);
-  ASSERT_EQ(points.size(), 4u);
+  EXPECT_EQ(c.ids, (std::vector<std::uint64_t>{7, 8, 5, 6}));
+  ASSERT_EQ(c.descriptors.rows, 4);
+  ASSERT_EQ(c.points.size(), 4u);
   for (int r = 0; r < 4; ++r) {
-    const int id = static_cast<int>(ids[static_cast<std::size_t>(r)]);
-    EXPECT_EQ(cv::norm(descriptors.row(r), descriptorOf(id), cv::NORM_HAMMING), 0.0) << id;
-    EXPECT_EQ(points[static_cast<std::size_t>(r)], Eigen::Vector3d(id, 0, 3));
+    const int id = static_cast<int>(c.ids[static_cast<std::size_t>(r)]);
+    EXPECT_EQ(cv::norm(c.descriptors.row(r), descriptorOf(id), cv::NORM_HAMMING), 0.0) << id;
+    EXPECT_EQ(c.points[static_cast<std::size_t>(r)], Eigen::Vector3d(id, 0, 3));
   }
   map.markBad({8, 0});
-  map.relocCandidates(100, ids, descriptors, points);  // more keyframes than there are
-  EXPECT_EQ(sorted(ids), (std::vector<std::uint64_t>{1, 2, 3, 4, 5, 6, 7}));
-  EXPECT_EQ(descriptors.rows, 7);
+  c = map.landmarksOf(map.newestKeyframes(100));  // more keyframes than there are
+  EXPECT_EQ(sorted(c.ids), (std::vector<std::uint64_t>{1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(c.descriptors.rows, 7);
 }
 
 TEST(LocalMap, WindowHoldsOlderCovisibleKeyframesFixedAndLeavesBadLandmarksOut) {
@@ -193,11 +191,8 @@ TEST(LocalMap, CulledKeyframeLeavesNearbyRelocWindowAndSavedMap) {
   ASSERT_TRUE(map.cull(2, 1));
   const auto near = map.keyframesNear(poseOf(2), 1.0, 10.0);
   EXPECT_EQ(sorted(near), (std::vector<std::uint64_t>{0, 1, 3}));
-  std::vector<std::uint64_t> ids;
-  cv::Mat descriptors;
-  std::vector<Eigen::Vector3d> points;
-  map.relocCandidates(2, ids, descriptors, points);  // kf3 and (culled) kf2: kf3's only
-  EXPECT_EQ(sorted(ids), (std::vector<std::uint64_t>{7, 8}));
+  EXPECT_EQ(map.newestKeyframes(2), (std::vector<std::uint64_t>{3}));  // kf2 culled
+  EXPECT_EQ(sorted(map.landmarksOf(map.newestKeyframes(2)).ids), (std::vector<std::uint64_t>{7, 8}));
   const BaWindow w = map.snapshotWindow(4, 1);
   EXPECT_EQ(std::count(w.keyframe_ids.begin(), w.keyframe_ids.end(), 2u), 0);
   // Its observations (landmarks 5 6 7) constrain its parent, through the fixed offset.

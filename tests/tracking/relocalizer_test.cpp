@@ -134,6 +134,29 @@ TEST_F(RelocalizerTest, AFrameOfAnotherSceneIsNotRelocalized) {
   }
 }
 
+TEST_F(RelocalizerTest, OnARevisitTheOldKeyframesNearTheLastPoseAreSearched) {
+  // Two newer keyframes of another room 3 m away: with only the newest one searched (as the
+  // tracker did before), the frame from between the two old keyframes is not relocalized.
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene elsewhere(camera, 99);
+  elsewhere.addDefaultRoom();
+  addKeyframe(elsewhere, orb_, config_, test::cameraPose({3.0, 0.0, 0.0}, 0.0, 0.0), 1.0, map_);
+  addKeyframe(elsewhere, orb_, config_, test::cameraPose({3.1, 0.0, 0.0}, 3.0, 0.0), 1.5, map_);
+  TrackerConfig newest_one = config_;
+  newest_one.reloc_keyframes = 1;
+  const Relocalizer relocalizer(newest_one, optimizer_);
+  const test::RenderedFrame f = scene_.render(kQueryPose, 0.0);
+  const OrbFeatures features = orb_.extractAll(grayOf(f), cv::Mat());
+  // The last pose by the first keyframe: it (and only it: 1 + 1 candidates) is searched.
+  const RelocalizationResult r =
+      relocalizer.relocalize(features, f.depth_m, map_, camera_, map_.keyframePose(0));
+  ASSERT_TRUE(r.ok);
+  EXPECT_LT(poseError(r.T_W_C, kQueryPose).translation_m, 0.01);
+  // A last pose far from every old keyframe (1 m, 40 degrees): the newest only, which fail.
+  const Eigen::Isometry3d far_pose = test::cameraPose({-0.9, 0.3, 0.5}, -40.0, 10.0);
+  EXPECT_FALSE(relocalizer.relocalize(features, f.depth_m, map_, camera_, far_pose).ok);
+}
+
 TEST_F(RelocalizerTest, FewerInliersDoOnlyNearTheLastTrackedPose) {
   // No number of inliers is enough by itself here: only the near-the-last-pose rule accepts.
   TrackerConfig near_only = config_;
@@ -158,10 +181,8 @@ TEST_F(RelocalizerTest, FewerInliersDoOnlyNearTheLastTrackedPose) {
 
 TEST_F(RelocalizerTest, LandmarksMarkedBadAreNotMatched) {
   // Every landmark of the map marked bad (seen on a mover): nothing is left to match.
-  std::vector<std::uint64_t> ids;
-  cv::Mat descriptors;
-  std::vector<Eigen::Vector3d> points;
-  map_.relocCandidates(config_.reloc_keyframes, ids, descriptors, points);
+  const std::vector<std::uint64_t> ids =
+      map_.landmarksOf(map_.newestKeyframes(config_.reloc_keyframes)).ids;
   ASSERT_GT(ids.size(), 100u);
   map_.markBad(ids);
   const RelocalizationResult r = relocalizeFrame(scene_, kQueryPose, kQueryPose);

@@ -243,19 +243,14 @@ int LocalMap::generation() const {
   return generation_;
 }
 
-void LocalMap::relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
-                               std::vector<Eigen::Vector3d>& points) const {
+std::vector<std::uint64_t> LocalMap::newestKeyframes(int count) const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::uint64_t> newest;
   const int n = static_cast<int>(keyframes_.size());
-  for (int k = n - 1; k >= std::max(0, n - keyframes); --k) {
-    if (!keyframes_[static_cast<std::size_t>(k)].culled)
-      newest.push_back(static_cast<std::uint64_t>(k));
+  for (int k = n - 1; k >= std::max(0, n - count); --k) {
+    if (!keyframes_[static_cast<std::size_t>(k)].culled) newest.push_back(static_cast<std::uint64_t>(k));
   }
-  LandmarkCandidates c = landmarksOfLocked(newest);
-  ids = std::move(c.ids);
-  descriptors = c.descriptors;
-  points = std::move(c.points);
+  return newest;
 }
 
 std::vector<KeyframeInfo> LocalMap::keyframes() const {

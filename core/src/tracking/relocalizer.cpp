@@ -15,6 +15,9 @@ namespace {
 constexpr double kGuidedRadiiPx[] = {60.0, 160.0};
 constexpr float kGuidedRatio = 0.9f;
 constexpr int kRelocRansacIterations = 1000;
+/// Keyframes within this many keyframe spacings (kf_max_translation_m, kf_max_rotation_deg) of
+/// the last pose are candidates too.
+constexpr double kNearLastFactor = 4.0;
 
 /// For each query: best train index (or -1) under the ratio test, among trains allowed by `near`.
 template <typename Near>
@@ -49,9 +52,24 @@ RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const 
                                              const LocalMap& map, const PinholeCamera& camera,
                                              const Eigen::Isometry3d& T_W_C_last) const {
   if (features.keypoints.size() < 6) return {};
-  LandmarkCandidates c;
-  map.relocCandidates(config_.reloc_keyframes, c.ids, c.descriptors, c.points);
+  const LandmarkCandidates c = map.landmarksOf(candidateKeyframes(map, T_W_C_last));
   return relocalizeNear(features, depth_m, c, camera, T_W_C_last, &T_W_C_last);
+}
+
+// The newest keyframes, and as many again of those nearest the last pose: on a revisit that
+// reuses the map the keyframes in view are old ones, and the newest see another part of it.
+std::vector<std::uint64_t> Relocalizer::candidateKeyframes(
+    const LocalMap& map, const Eigen::Isometry3d& T_W_C_last) const {
+  std::vector<std::uint64_t> ids = map.newestKeyframes(config_.reloc_keyframes);
+  const std::vector<std::uint64_t> near =
+      map.keyframesNear(T_W_C_last, kNearLastFactor * config_.kf_max_translation_m,
+                        kNearLastFactor * config_.kf_max_rotation_deg);
+  const std::size_t most = ids.size() + static_cast<std::size_t>(config_.reloc_keyframes);
+  for (const auto k : near) {
+    if (ids.size() >= most) break;
+    if (std::find(ids.begin(), ids.end(), k) == ids.end()) ids.push_back(k);
+  }
+  return ids;
 }
 
 RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,

@@ -85,9 +85,8 @@ class LocalMap {
   std::vector<PoseUpdate> applyLoopCorrection(const LoopCorrection& correction);
   int generation() const;  ///< the newest loop correction applied (0 = none)
 
-  /// Landmarks seen by the newest `keyframes` keyframes (ids, descriptors stacked, positions).
-  void relocCandidates(int keyframes, std::vector<std::uint64_t>& ids, cv::Mat& descriptors,
-                       std::vector<Eigen::Vector3d>& points) const;
+  /// The newest `count` keyframes not culled, the newest first.
+  std::vector<std::uint64_t> newestKeyframes(int count) const;
   std::vector<KeyframeInfo> keyframes() const;
 
   /// Keyframes not culled whose pose is within `max_translation_m` and `max_rotation_deg` of

@@ -22,7 +22,7 @@ struct RelocalizationResult {
 };
 
 /// Recovers the pose of a frame from ORB descriptor matches (brute-force Hamming, ratio test)
-/// against the landmarks of the newest keyframes, PnP-RANSAC without a prior, then refinement.
+/// against the landmarks of the newest keyframes and of those near the last pose, PnP-RANSAC without a prior, then refinement.
 /// Matches are first searched near the landmarks' projections with the last known pose, then,
 /// if that fails, among all candidates.
 class Relocalizer {
@@ -44,6 +44,8 @@ class Relocalizer {
                                       const LandmarkCandidates& c, const PinholeCamera& camera,
                                       const Eigen::Isometry3d& T_W_C_hint,
                                       const Eigen::Isometry3d* T_W_C_last) const;
+  std::vector<std::uint64_t> candidateKeyframes(const LocalMap& map,
+                                                const Eigen::Isometry3d& T_W_C_last) const;
   /// match[q] = candidate index of query q or -1.
   RelocalizationResult solve(const OrbFeatures& features, const cv::Mat& dist,
                              const cv::Mat& depth_m, const std::vector<std::uint64_t>& ids,
