@@ -31,6 +31,9 @@ class PluginBackend final : public MapBackend {
   bool importMap(const std::string& dir) override { return inner_->importMap(dir); }
   bool canDeintegrate() const override { return inner_->canDeintegrate(); }
   void deintegrate(const KeyframeView& view) override { inner_->deintegrate(view); }
+  void moveKeyframe(const KeyframeView& from, const KeyframeView& to) override {
+    inner_->moveKeyframe(from, to);
+  }
 
  private:
   std::shared_ptr<void> handle_;

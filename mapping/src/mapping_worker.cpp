@@ -352,9 +352,9 @@ void MappingWorker::moveKeyframesLocked(const std::vector<std::uint64_t>& ids) {
     ScopedStageTimer one(timings_, "mapping_move_keyframe");
     StaticPoints sp;
     recordPointsLocked(id, sp);
-    backend_->deintegrate(
-        keyframeView(id, rec.timestamp_s, rec.T_integrated, camera_, rec.bgr, sp));
-    backend_->integrate(keyframeView(id, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
+    backend_->moveKeyframe(
+        keyframeView(id, rec.timestamp_s, rec.T_integrated, camera_, rec.bgr, sp),
+        keyframeView(id, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
     rec.T_integrated = rec.T_current;
     ++reintegrated_;
   }

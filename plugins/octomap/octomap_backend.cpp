@@ -57,6 +57,25 @@ class OctomapBackend final : public MapBackend {
     if (keyframes_ > 0) --keyframes_;
   }
 
+  // Both poses' rays cast at once (one on another thread) and netted: a cell both poses update
+  // alike (most free cells of a move by a few cm) is left alone. The same map as deintegrate()
+  // then integrate() but where a cell's clamping cut an update off.
+  void moveKeyframe(const KeyframeView& from, const KeyframeView& to) override {
+    drain();
+    auto to_cells = std::async(std::launch::async, [this, &to] { return castView(to); });
+    const plugin::RayCells from_cells = castView(from);
+    const auto change = plugin::netChange(from_cells, to_cells.get(), tree_->getProbHitLog(),
+                                          tree_->getProbMissLog());
+    for (const plugin::CellChange& c : change) {
+      if (c.taken_back) {
+        takeBack(c.key, c.log_odds);
+      } else {
+        tree_->updateNode(c.key, c.log_odds, /*lazy_eval=*/true);
+      }
+    }
+    dirty_inner_ = true;
+  }
+
   void updatePose(std::uint64_t, const Eigen::Isometry3d&) override {}
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
   bool fusesViews() const override { return true; }
@@ -112,23 +131,12 @@ class OctomapBackend final : public MapBackend {
   /// The view's points reduced to distinct voxel centres (discretize_), its rays cast on another
   /// thread, the previous view's cells written into the tree meanwhile, each with `sign`.
   void castAndApply(const KeyframeView& view, int sign) {
-    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
-    const Eigen::Vector3d o = view.T_W_C.translation();
-    octomap::Pointcloud cloud;
-    if (discretize_) {
-      cloud = plugin::distinctCellCentres(*tree_, *view.points_C, T);
-    } else {
-      cloud.reserve(view.points_C->size());
-      for (const auto& p_C : *view.points_C) {
-        const Eigen::Vector3f p = T * p_C;
-        cloud.push_back(p.x(), p.y(), p.z());
-      }
-    }
+    octomap::Pointcloud cloud = worldCloud(view);
     // The caster is free once the previous keyframe's rays are in; its cells go into the tree
     // while this keyframe's rays are cast.
     std::unique_ptr<Cells> previous = pending_.valid() ? pending_.get() : nullptr;
     pending_ = std::async(std::launch::async, [this, sign, cloud = std::move(cloud),
-                                               origin = octomap::point3d(o.x(), o.y(), o.z())] {
+                                               origin = originOf(view)] {
       auto cells = std::make_unique<Cells>();
       static_cast<plugin::RayCells&>(*cells) =
           plugin::castRays(caster_, cloud, origin, max_range_m_);
@@ -137,6 +145,25 @@ class OctomapBackend final : public MapBackend {
     });
     if (previous) apply(*previous);
     dirty_inner_ = true;
+  }
+  /// The view's points in the world frame (reduced to distinct voxel centres: discretize_).
+  octomap::Pointcloud worldCloud(const KeyframeView& view) const {
+    const Eigen::Isometry3f T = view.T_W_C.cast<float>();
+    octomap::Pointcloud cloud;
+    if (discretize_) return plugin::distinctCellCentres(*tree_, *view.points_C, T);
+    cloud.reserve(view.points_C->size());
+    for (const auto& p_C : *view.points_C) {
+      const Eigen::Vector3f p = T * p_C;
+      cloud.push_back(p.x(), p.y(), p.z());
+    }
+    return cloud;
+  }
+  static octomap::point3d originOf(const KeyframeView& view) {
+    const Eigen::Vector3d o = view.T_W_C.translation();
+    return {static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z())};
+  }
+  plugin::RayCells castView(const KeyframeView& view) const {
+    return plugin::castRays(caster_, worldCloud(view), originOf(view), max_range_m_);
   }
   /// This run's sensor model and clamping (a loaded tree keeps its log-odds, not its model).
   void configure(octomap::OcTree& tree) const {

@@ -43,6 +43,37 @@ RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
   return cells;
 }
 
+std::vector<CellChange> netChange(const RayCells& from, const RayCells& to, float hit_log_odds,
+                                  float miss_log_odds) {
+  std::vector<CellChange> change;
+  change.reserve(from.free.size() + from.occupied.size());
+  FlatIndex index(2 * (from.free.size() + from.occupied.size()));
+  const auto add = [&](const std::vector<octomap::OcTreeKey>& keys, float log_odds,
+                       bool taken_back) {
+    for (const octomap::OcTreeKey& key : keys) {
+      const auto [i, inserted] =
+          index.tryEmplace(packed(key), static_cast<std::uint32_t>(change.size()));
+      if (inserted) {
+        change.push_back({key, log_odds, taken_back});
+      } else {
+        change[i].log_odds += log_odds;
+      }
+    }
+  };
+  add(from.free, -miss_log_odds, true);
+  add(from.occupied, -hit_log_odds, true);
+  add(to.free, miss_log_odds, false);
+  add(to.occupied, hit_log_odds, false);
+  // A cell's sum cancels exactly when it is the same kind in both (x - x); a free cell of one
+  // and an occupied cell of the other keep hit - miss.
+  std::size_t kept = 0;
+  for (const CellChange& c : change) {
+    if (c.log_odds != 0.0f) change[kept++] = c;
+  }
+  change.resize(kept);
+  return change;
+}
+
 octomap::Pointcloud distinctCellCentres(const octomap::OcTree& tree,
                                         const std::vector<Eigen::Vector3f>& points_C,
                                         const Eigen::Isometry3f& T_W_C) {

@@ -17,6 +17,20 @@ struct RayCells {
   std::vector<octomap::OcTreeKey> free, occupied;
 };
 
+/// A cell's net log-odds change; taken_back: the cell is one of the view taken out (a change that
+/// brings it back to unknown deletes it).
+struct CellChange {
+  octomap::OcTreeKey key;
+  float log_odds = 0.0f;
+  bool taken_back = false;
+};
+
+/// What taking `from` out and putting `to` in changes, cell by cell: +hit / +miss for the
+/// occupied / free cells of `to`, minus the same for those of `from`; cells whose changes cancel
+/// (a cell free or occupied in both) left out. Cells of `from` first, each in the order first met.
+std::vector<CellChange> netChange(const RayCells& from, const RayCells& to, float hit_log_odds,
+                                  float miss_log_odds);
+
 /// `tree` gives the key grid and the ray traversal (OcTree::computeRayKeys()); only read.
 RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
                   const octomap::point3d& origin, double max_range_m);

@@ -144,14 +144,16 @@ TEST(OctomapBackend, AKeyframeTakenOutLeavesNoOccupiedCell) {
   EXPECT_LT(leaves, run.exported("full").getNumLeafNodes() / 5);
 }
 
-// Keyframes 2 and 5 of 8 integrated 4 cm / 2 deg off, then taken out and in again at their
-// true poses: the map of the true poses (measured: Jaccard 0.9987 on occupied cells; the bound
-// leaves room for clamping, which the order of updates changes). The map of the wrong poses is
-// farther off (0.81).
-TEST(OctomapBackend, KeyframesMovedOutAndInGiveTheMapOfTheirNewPoses) {
+// Keyframes 2 and 5 of 8 integrated 4 cm / 2 deg off, then moved to their true poses, taken out
+// and in again (`netted` false) or by moveKeyframe(), which applies only the cells whose update
+// changes: the map of the true poses (measured: Jaccard 0.9987 on occupied cells both ways; the
+// bound leaves room for clamping, which the order of updates changes). The map of the wrong
+// poses is farther off (0.81).
+void expectMovedKeyframesGiveTheMapOfTheirNewPoses(bool netted) {
   const auto registry = BackendRegistry::scan({test::pluginDir()});
   if (registry.pluginPath("octomap").empty()) GTEST_SKIP() << "octomap backend not built";
   const int n = 8;
+  const std::string tag = netted ? "netted_" : "out_in_";  // tests may run at once
   OctomapRun moved(registry, n), truth(registry, n);
   const Eigen::Isometry3d off = Eigen::Translation3d(0.04, -0.02, 0.0) *
                                 Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ());
@@ -161,17 +163,42 @@ TEST(OctomapBackend, KeyframesMovedOutAndInGiveTheMapOfTheirNewPoses) {
     moved.backend->integrate(moved.view(k, wrong(k) ? off * T : T));
     truth.backend->integrate(truth.view(k, T));
   }
-  const octomap::OcTree& reference = truth.exported("truth");
-  const double before = occupiedJaccard(moved.exported("before"), reference);
+  const octomap::OcTree& reference = truth.exported(tag + "truth");
+  const double before = occupiedJaccard(moved.exported(tag + "before"), reference);
   for (int k : {2, 5}) {
     const Eigen::Isometry3d& T = moved.frames[static_cast<std::size_t>(k)].T_W_C;
-    moved.backend->deintegrate(moved.view(k, off * T));
-    moved.backend->integrate(moved.view(k, T));
+    if (netted) {
+      moved.backend->moveKeyframe(moved.view(k, off * T), moved.view(k, T));
+    } else {
+      moved.backend->deintegrate(moved.view(k, off * T));
+      moved.backend->integrate(moved.view(k, T));
+    }
   }
-  const double after = occupiedJaccard(moved.exported("after"), reference);
+  const double after = occupiedJaccard(moved.exported(tag + "after"), reference);
   EXPECT_EQ(moved.backend->stats().keyframes, static_cast<std::size_t>(n));
   EXPECT_GE(after, 0.99) << "before " << before;
   EXPECT_LT(before, 0.97);
+}
+
+TEST(OctomapBackend, KeyframesMovedOutAndInGiveTheMapOfTheirNewPoses) {
+  expectMovedKeyframesGiveTheMapOfTheirNewPoses(false);
+}
+
+TEST(OctomapBackend, KeyframesMovedByNetChangeGiveTheMapOfTheirNewPoses) {
+  expectMovedKeyframesGiveTheMapOfTheirNewPoses(true);
+}
+
+// A keyframe moved to where it is changes nothing: every cell's update cancels.
+TEST(OctomapBackend, AKeyframeMovedToItsOwnPoseLeavesTheMapAsItWas) {
+  const auto registry = BackendRegistry::scan({test::pluginDir()});
+  if (registry.pluginPath("octomap").empty()) GTEST_SKIP() << "octomap backend not built";
+  OctomapRun run(registry, 3);
+  for (int k = 0; k < 3; ++k) run.backend->integrate(run.view(k, run.frames[k].T_W_C));
+  const std::size_t leaves = run.exported("unmoved").getNumLeafNodes();
+  const std::size_t occupied = run.backend->stats().elements;
+  run.backend->moveKeyframe(run.view(1, run.frames[1].T_W_C), run.view(1, run.frames[1].T_W_C));
+  EXPECT_EQ(run.backend->stats().elements, occupied);
+  EXPECT_EQ(run.exported("moved_in_place").getNumLeafNodes(), leaves);
 }
 
 }  // namespace

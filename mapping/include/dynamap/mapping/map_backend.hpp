@@ -95,6 +95,13 @@ class MapBackend {
     (void)view;
     throw MappingError("this backend cannot take a keyframe out (canDeintegrate() is false)");
   }
+  /// Moves an integrated keyframe from `from` (its pose when it went in) to `to` (same image,
+  /// new pose): deintegrate(from) then integrate(to), or what amounts to it where a backend can
+  /// do it cheaper (stats().keyframes unchanged). Only where canDeintegrate().
+  virtual void moveKeyframe(const KeyframeView& from, const KeyframeView& to) {
+    deintegrate(from);
+    integrate(to);
+  }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).
@@ -104,7 +111,8 @@ using BackendParams = std::map<std::string, std::string>;
 /// caller; throws MappingError for a bad parameter.
 using BackendFactoryFn = MapBackend* (*)(const BackendParams& params);
 /// v2: MapBackend::needsPoints(); v3: MapBackend::importMap(); v4: canDeintegrate() and
-/// deintegrate() (a plugin built for an older version has a shorter vtable: refused by name).
-inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v4";
+/// deintegrate(); v5: moveKeyframe() (a plugin built for an older version has a shorter vtable:
+/// refused by name).
+inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v5";
 
 }  // namespace dynamap
