@@ -1,5 +1,6 @@
 #include "ray_cells.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 #include "dynamap/mapping/flat_index.hpp"
@@ -44,15 +45,24 @@ RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
 }
 
 std::vector<CellChange> netChange(const RayCells& from, const RayCells& to, float hit_log_odds,
-                                  float miss_log_odds) {
+                                  float miss_log_odds, int part, int parts) {
+  // The cells of this part: a hash of the key other than FlatIndex's slot hash.
+  const auto mine = [&](std::uint64_t k) {
+    return parts <= 1 ||
+           static_cast<int>(((k * 0xD6E8FEB86659FD93ull) >> 32) % static_cast<unsigned>(parts)) ==
+               part;
+  };
+  const std::size_t from_cells = from.free.size() + from.occupied.size();
   std::vector<CellChange> change;
-  change.reserve(from.free.size() + from.occupied.size());
-  FlatIndex index(2 * (from.free.size() + from.occupied.size()));
+  change.reserve(from_cells / std::max(1, parts) + 1024);
+  // Most of `to`'s cells are `from`'s: the table grows if not.
+  FlatIndex index(from_cells * 5 / 4 / std::max(1, parts) + 1024);
   const auto add = [&](const std::vector<octomap::OcTreeKey>& keys, float log_odds,
                        bool taken_back) {
     for (const octomap::OcTreeKey& key : keys) {
-      const auto [i, inserted] =
-          index.tryEmplace(packed(key), static_cast<std::uint32_t>(change.size()));
+      const std::uint64_t k = packed(key);
+      if (!mine(k)) continue;
+      const auto [i, inserted] = index.tryEmplace(k, static_cast<std::uint32_t>(change.size()));
       if (inserted) {
         change.push_back({key, log_odds, taken_back});
       } else {

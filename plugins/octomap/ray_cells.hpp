@@ -28,8 +28,10 @@ struct CellChange {
 /// What taking `from` out and putting `to` in changes, cell by cell: +hit / +miss for the
 /// occupied / free cells of `to`, minus the same for those of `from`; cells whose changes cancel
 /// (a cell free or occupied in both) left out. Cells of `from` first, each in the order first met.
+/// `part` of `parts`: only the cells a hash of the key puts in that part (the parts are disjoint
+/// and together all cells), so that the parts can be netted on different threads.
 std::vector<CellChange> netChange(const RayCells& from, const RayCells& to, float hit_log_odds,
-                                  float miss_log_odds);
+                                  float miss_log_odds, int part = 0, int parts = 1);
 
 /// `tree` gives the key grid and the ray traversal (OcTree::computeRayKeys()); only read.
 RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
