@@ -3,6 +3,7 @@
 #include <exception>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include "dynamap/core/dynamic/dynamic_motion_filter.hpp"
@@ -46,6 +47,21 @@ struct System::Impl {
   void lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
                  std::vector<KeyframePacketPtr>& mapped);
   void releasePending(std::vector<KeyframePacketPtr>& mapped);
+  /// finish()'s parts: the last bundle adjustment, its poses to the mapper, the mapper's queue
+  /// and last window.
+  void finishTracking() {
+    ScopedStageTimer timer(timings, "finish_tracking");
+    tracker->finish();
+  }
+  void publishFinalPoses() {
+    std::vector<PoseUpdate> final_poses;
+    for (const auto& kf : tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
+    mapper->applyPoseUpdates(final_poses);
+  }
+  void drainMapper() {
+    ScopedStageTimer timer(timings, "finish_mapping_drain");
+    mapper->drain();
+  }
 };
 
 void System::Impl::loadMap(const std::string& dir) {
@@ -292,18 +308,33 @@ void System::finish() {
   s.finished = true;
   s.releasePending(s.last_mapped);
   if (s.tracker) {
-    // The last bundle adjustment first (tens of ms), then the mapper's last keyframes: those
-    // still queued or in its window go into the map at their final poses instead of going in at
-    // the poses before and being moved again (50-100 ms each for octomap at 3 cm).
-    {
-      ScopedStageTimer timer(s.timings, "finish_tracking");  // last bundle adjustment
-      s.tracker->finish();
+    if (s.mapper->drainsAfterFinalPoses()) {
+      // The mapper's last keyframes go in once, at their final poses, instead of going in at the
+      // poses before and being moved again (50-100 ms each for octomap at 3 cm).
+      s.finishTracking();
+      s.publishFinalPoses();
+      s.drainMapper();
+    } else {
+      // The mapper integrates its last keyframes on the other core while the last bundle
+      // adjustment holds this one (it needs no pose; the final poses come after).
+      std::exception_ptr drain_failed;
+      std::thread drain([&] {
+        try {
+          s.drainMapper();
+        } catch (...) {
+          drain_failed = std::current_exception();
+        }
+      });
+      try {
+        s.finishTracking();
+      } catch (...) {
+        drain.join();
+        throw;
+      }
+      drain.join();
+      if (drain_failed) std::rethrow_exception(drain_failed);
+      s.publishFinalPoses();
     }
-    std::vector<PoseUpdate> final_poses;
-    for (const auto& kf : s.tracker->keyframes()) final_poses.push_back({kf.id, kf.T_W_C});
-    s.mapper->applyPoseUpdates(final_poses);
-    ScopedStageTimer timer(s.timings, "finish_mapping_drain");  // the queue, the last window
-    s.mapper->drain();
   }
   ScopedStageTimer timer(s.timings, "finish_mapping");  // after the final poses
   s.mapper->finish();

@@ -267,6 +267,32 @@ TEST(MappingWorker, MovesOnlyTheMovedKeyframesOfABackendThatCanTakeThemOut) {
   }
 }
 
+// Final poses published before drain() (System::finish() for a backend that re-integrates,
+// drainsAfterFinalPoses()) reach the keyframes still waiting in the window before they go in:
+// each goes in once, at its final pose; none is taken out again and there is no rebuild.
+TEST(MappingWorker, FinalPosesBeforeTheDrainPlaceTheLastKeyframesOnce) {
+  FakeLog log;
+  log.released = true;
+  MappingWorker worker(
+      std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate, false, true),
+      SyntheticScene::camera(), countingOptions(), 4, nullptr);
+  EXPECT_TRUE(worker.drainsAfterFinalPoses());
+  std::vector<PoseUpdate> updates;
+  for (std::uint64_t id = 0; id < 3; ++id) {
+    const auto kf = packet(id);
+    worker.push(kf);
+    updates.push_back({id, Eigen::Translation3d(0.05, 0, 0) * kf->T_W_C});
+  }
+  worker.applyPoseUpdates(updates);
+  worker.drain();
+  worker.finish();
+  EXPECT_EQ(log.resets, 0);
+  EXPECT_TRUE(log.taken_out.empty());
+  EXPECT_EQ(log.integrated, (std::vector<std::uint64_t>{0, 1, 2}));
+  for (const auto& u : updates) EXPECT_TRUE(log.poses.at(u.keyframe_id).isApprox(u.T_W_C));
+  EXPECT_EQ(worker.reintegratedKeyframes(), 0u);
+}
+
 // The final pass (mapping.visibility_final_pass, the offline extra): the backend gets each
 // keyframe exactly once, in finish(), with its final pose, and never a reset. Online (the
 // default) each keyframe is integrated when judged, here in drain(); the final poses then cost

@@ -64,6 +64,12 @@ class MappingWorker {
   /// tracker's last bundle adjustment; applyPoseUpdates() may be called during and after it.
   /// finish() does it if it was not called. Idempotent.
   void drain();
+  /// true: the backend follows moved keyframes by integrating them again (kReintegrate, online),
+  /// so the last keyframes are best drained after the final poses came (they then go in once,
+  /// at those poses); false: beside the last bundle adjustment.
+  bool drainsAfterFinalPoses() const {
+    return !deferred() && backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate;
+  }
   /// Drains the queue, stops the thread, applies the final poses (rebuild if needed). Idempotent.
   void finish();
   /// Blocks until the keyframes queued so far have been taken and processed (those still in a
