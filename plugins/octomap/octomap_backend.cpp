@@ -150,8 +150,8 @@ class OctomapBackend final : public MapBackend {
   /// The view's points in the world frame (reduced to distinct voxel centres: discretize_).
   octomap::Pointcloud worldCloud(const KeyframeView& view) const {
     const Eigen::Isometry3f T = view.T_W_C.cast<float>();
-    octomap::Pointcloud cloud;
     if (discretize_) return plugin::distinctCellCentres(*tree_, *view.points_C, T);
+    octomap::Pointcloud cloud;
     cloud.reserve(view.points_C->size());
     for (const auto& p_C : *view.points_C) {
       const Eigen::Vector3f p = T * p_C;

@@ -46,17 +46,16 @@ RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
 
 std::vector<CellChange> netChange(const RayCells& from, const RayCells& to, float hit_log_odds,
                                   float miss_log_odds, int part, int parts) {
+  const auto n_parts = static_cast<unsigned>(std::max(1, parts));
   // The cells of this part: a hash of the key other than FlatIndex's slot hash.
   const auto mine = [&](std::uint64_t k) {
-    return parts <= 1 ||
-           static_cast<int>(((k * 0xD6E8FEB86659FD93ull) >> 32) % static_cast<unsigned>(parts)) ==
-               part;
+    return ((k * 0xD6E8FEB86659FD93ull) >> 32) % n_parts == static_cast<unsigned>(part);
   };
   const std::size_t from_cells = from.free.size() + from.occupied.size();
   std::vector<CellChange> change;
-  change.reserve(from_cells / std::max(1, parts) + 1024);
+  change.reserve(from_cells / n_parts + 1024);
   // Most of `to`'s cells are `from`'s: the table grows if not.
-  FlatIndex index(from_cells * 5 / 4 / std::max(1, parts) + 1024);
+  FlatIndex index(from_cells * 5 / 4 / n_parts + 1024);
   const auto add = [&](const std::vector<octomap::OcTreeKey>& keys, float log_odds,
                        bool taken_back) {
     for (const octomap::OcTreeKey& key : keys) {
