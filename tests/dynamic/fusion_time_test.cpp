@@ -177,6 +177,32 @@ TEST(FusionOverTime, ACarriedBoxAtTheBorderMasksNoWallOnceItsWalkerLeft) {
   EXPECT_GT(carried(true, true), 0.95);
 }
 
+// The same at the right border, where the sensor measures nothing (its blind band, and here
+// dropouts beside it): once the walker left, the carried box's centre holds no depth at all. It
+// masks nothing (before, an empty depth cut fell back to the whole box: a strip of wall and
+// band, 30-40 px wide, on the reversed teddy_dyn_crowd_dev).
+TEST(FusionOverTime, ACarriedBoxOverTheSensorsBlindBandMasksNothingOnceItsWalkerLeft) {
+  const cv::Rect walker(596, 150, 44, 250), band(596, 0, 44, 480);
+  const auto carried = [&](bool check) {
+    Scene s0;
+    s0.place(walker, 2.f);
+    DynamicConfig c;
+    c.carried_border_exit = check;
+    RegionFusion fusion(c, ClassTable(c));
+    fusion.fuse(FusionMode::kBoth, s0.depth, s0.points, s0.flagged(walker), {box(walker)});
+    Scene s1;
+    s1.place(band, 0.f);
+    FusionEvidence ev;
+    ev.prev_points = s1.points;  // no flow
+    const FusionResult r = fusion.fuse(FusionMode::kBoth, s1.depth, s1.points, s1.quiet, {}, ev);
+    EXPECT_EQ(r.objects.size(), 1u);
+    EXPECT_TRUE(!r.objects.empty() && r.objects[0].carried);
+    return maskedShare(r.mask, walker);
+  };
+  EXPECT_LT(carried(true), 0.01);
+  EXPECT_GT(carried(false), 0.95) << "the scene no longer shows what the check is for";
+}
+
 TEST(FusionOverTime, OnlyProvenStaticPointsCarveAMovingRegion) {
   // A walker whose depth cut includes a standing person at the same depth: the standing
   // person's points carve it out only when they are proven static (landmarks over time).
