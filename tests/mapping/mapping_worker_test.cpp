@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
@@ -111,6 +112,49 @@ TEST(MappingWorker, BoundedQueueDropsOnTryPushAndDrainsOnFinish) {
   EXPECT_EQ(timings.stats("mapping_integrate").count, 2u);
   ASSERT_EQ(log.points.size(), 2u);
   EXPECT_GT(log.points[0], 1000u);
+}
+
+// A backend that drains after the final poses keeps a short queue: what is queued at finish()
+// goes in after the final bundle adjustment, so the queue bounds the finish. One that drains
+// beside it keeps the whole capacity (bursts of the mapper's work cost the tracker nothing).
+TEST(MappingWorker, ABackendThatDrainsAfterTheFinalPosesKeepsAShortQueue) {
+  for (const PoseUpdateMode mode : {PoseUpdateMode::kReintegrate, PoseUpdateMode::kInPlace}) {
+    FakeLog log;  // integrate() blocks until released: the worker holds the first keyframe
+    StaticPointsOptions options = countingOptions();
+    options.free_space.enabled = false;  // integrate on arrival (no neighbour window)
+    options.window_after_s = 0.0;        // ... nor judgement window
+    options.window_batch_s = 0.0;
+    MappingWorker worker(std::make_unique<FakeBackend>(&log, mode), SyntheticScene::camera(),
+                         options, 16, nullptr);
+    std::vector<KeyframePacketPtr> packets;
+    for (std::uint64_t id = 0; id < 12; ++id) packets.push_back(packet(id));
+    std::atomic<int> pushed{0};
+    std::thread tracker([&] {
+      for (const auto& kf : packets) worker.push(kf), ++pushed;
+    });
+    // Until the pushes stop (all 12, or blocked at the short queue), then a while longer.
+    const int short_limit = 1 + static_cast<int>(MappingWorker::kAfterFinalPosesQueue);
+    for (int i = 0; i < 5000 && pushed.load() < 12 && pushed.load() < short_limit; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const int before_release = pushed.load();
+    {
+      std::lock_guard<std::mutex> lock(log.mutex);
+      log.released = true;
+    }
+    log.cv.notify_all();
+    tracker.join();
+    worker.finish();
+    EXPECT_EQ(log.integrated.size(), 12u);
+    if (mode == PoseUpdateMode::kReintegrate) {
+      EXPECT_TRUE(worker.drainsAfterFinalPoses());
+      EXPECT_LE(before_release, short_limit);  // the one the worker holds and the queue's 4
+    } else {
+      EXPECT_FALSE(worker.drainsAfterFinalPoses());
+      EXPECT_EQ(before_release, 12);
+    }
+  }
 }
 
 #ifdef __linux__

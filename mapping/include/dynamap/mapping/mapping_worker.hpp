@@ -41,6 +41,7 @@ class MappingWorker {
   static constexpr double kReintegrateTranslationM = 0.01;
   static constexpr double kReintegrateRotationRad = 0.5 * 3.14159265358979 / 180.0;
   static constexpr std::uint64_t kSupplementBit = std::uint64_t{1} << 63;
+  static constexpr std::size_t kAfterFinalPosesQueue = 4;
 
   MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeCamera& camera,
                 const StaticPointsOptions& options, std::size_t queue_capacity,
@@ -54,7 +55,8 @@ class MappingWorker {
   /// to it). Returns false if the backend cannot take a saved map; throws MappingError naming the
   /// file and the field for a missing, corrupt or mismatched one. Call before the first push().
   bool importMap(const std::string& dir);
-  /// Blocks while the queue is full.
+  /// Blocks while the queue is full (for a backend that drainsAfterFinalPoses(), at
+  /// kAfterFinalPosesQueue keyframes).
   void push(KeyframePacketPtr kf);
   /// Non-blocking; returns false (and counts a drop) when the queue is full.
   bool tryPush(KeyframePacketPtr kf);
@@ -172,6 +174,10 @@ class MappingWorker {
   PinholeCamera camera_;
   StaticPointsOptions options_;
   std::size_t capacity_;
+  /// What push() lets queue up: capacity_, at most kAfterFinalPosesQueue for a backend that
+  /// drains after the final poses (what is queued at finish() goes in after the final bundle
+  /// adjustment, not beside it: the queue bounds the finish; octomap x1 with 16: 1.1-1.5 s).
+  std::size_t blocking_capacity_;
   int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
