@@ -43,8 +43,6 @@ MappingWorker::MappingWorker(std::unique_ptr<MapBackend> backend, const PinholeC
       timings_(timings) {
   if (!backend_) throw MappingError("MappingWorker: null backend");
   if (backend_->fusesViews()) options_.mask_dilation_px = options_.fused_mask_dilation_px;
-  blocking_capacity_ =
-      drainsAfterFinalPoses() ? std::min(capacity_, kAfterFinalPosesQueue) : capacity_;
   thread_ = std::thread([this] { run(); });
 }
 
@@ -60,9 +58,10 @@ MappingWorker::~MappingWorker() {
 
 void MappingWorker::push(KeyframePacketPtr kf) {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (queue_.size() >= blocking_capacity_ && !stopping_) {  // the tracker waits for the mapper
+  const std::size_t limit = pushLimit();
+  if (queue_.size() >= limit && !stopping_) {  // the tracker waits for the mapper
     ScopedStageTimer wait(timings_, "mapping_wait");
-    not_full_.wait(lock, [this] { return queue_.size() < blocking_capacity_ || stopping_; });
+    not_full_.wait(lock, [&] { return queue_.size() < limit || stopping_; });
   }
   if (stopping_) return;
   queue_.push_back(std::move(kf));

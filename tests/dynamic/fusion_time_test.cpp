@@ -149,10 +149,6 @@ TEST(FusionOverTime, AMissedDetectionKeepsItsMaskCarriedByTheFlow) {
   EXPECT_EQ(r.clusters, 0);
 }
 
-// A walker at the left image border walks out of the image; the detector reports nothing more.
-// The carried box's centre now shows only the wall: it masks nothing there (without the check it
-// took the wall, 12-15 k pixels a frame on teddy_dyn_crowd_dev). A walker still there at his own
-// depth, the detector missing him, keeps his mask.
 /// The share of `walker` masked in `next`, the frame after one where he was detected at 2 m
 /// (with carried_border_exit = `check`): no detection and no flow in `next`, his points
 /// flagged there if `flagged`.
@@ -172,6 +168,10 @@ double carriedMaskShare(const cv::Rect& walker, bool check, const Scene& next, b
   return maskedShare(r.mask, walker);
 }
 
+// A walker at the left image border walks out of the image; the detector reports nothing more.
+// The carried box's centre now shows only the wall: it masks nothing there (without the check it
+// took the wall, 12-15 k pixels a frame on teddy_dyn_crowd_dev). A walker still there at his own
+// depth, the detector missing him, keeps his mask.
 TEST(FusionOverTime, ACarriedBoxAtTheBorderMasksNoWallOnceItsWalkerLeft) {
   const cv::Rect walker(0, 150, 70, 250);
   const auto carried = [&](bool check, bool still_there) {

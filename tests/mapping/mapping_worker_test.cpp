@@ -130,7 +130,10 @@ TEST(MappingWorker, ABackendThatDrainsAfterTheFinalPosesKeepsAShortQueue) {
     for (std::uint64_t id = 0; id < 12; ++id) packets.push_back(packet(id));
     std::atomic<int> pushed{0};
     std::thread tracker([&] {
-      for (const auto& kf : packets) worker.push(kf), ++pushed;
+      for (const auto& kf : packets) {
+        worker.push(kf);
+        ++pushed;
+      }
     });
     // Until the pushes stop (all 12, or blocked at the short queue), then a while longer.
     const int short_limit = 1 + static_cast<int>(MappingWorker::kAfterFinalPosesQueue);

@@ -127,10 +127,10 @@ cv::Mat objectPixels(const cv::Mat& depth_m, const cv::Rect& box_in, double band
     if (mode > 0.0 && prior_only && prior_depth_m > 0.0)
       return cv::Mat::zeros(depth_m.size(), CV_8UC1);
   }
-  // No depth at all in the centre of a carried border box (the sensor's blind band at the
-  // image edge): nothing there is the object's depth either.
-  if (mode <= 0.0 && prior_only) return cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (mode <= 0.0) {
+    // No depth at all in the centre of a carried border box (the sensor's blind band at the
+    // image edge): nothing there is the object's depth either.
+    if (prior_only) return cv::Mat::zeros(depth_m.size(), CV_8UC1);
     const bool has_depth = cut && depthMode(z(inner), 0.0) > 0.0;
     return has_depth ? cv::Mat::zeros(depth_m.size(), CV_8UC1) : cv::Mat();
   }

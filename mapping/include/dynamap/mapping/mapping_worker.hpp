@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -166,6 +167,12 @@ class MappingWorker {
   /// Keyframes go to the backend only in finish() (see the class comment).
   bool deferred() const { return options_.visibility_final_pass; }
   /// The backend needs the stored keyframes again for a rebuild.
+  /// What push() lets queue up: capacity_, at most kAfterFinalPosesQueue for a backend that
+  /// drains after the final poses (what is queued at finish() goes in after the final bundle
+  /// adjustment, not beside it: the queue bounds the finish; octomap x1 with 16: 1.1-1.5 s).
+  std::size_t pushLimit() const {
+    return drainsAfterFinalPoses() ? std::min(capacity_, kAfterFinalPosesQueue) : capacity_;
+  }
   bool keepsDepth() const {
     return deferred() || backend_->poseUpdateMode() == PoseUpdateMode::kReintegrate;
   }
@@ -174,10 +181,6 @@ class MappingWorker {
   PinholeCamera camera_;
   StaticPointsOptions options_;
   std::size_t capacity_;
-  /// What push() lets queue up: capacity_, at most kAfterFinalPosesQueue for a backend that
-  /// drains after the final poses (what is queued at finish() goes in after the final bundle
-  /// adjustment, not beside it: the queue bounds the finish; octomap x1 with 16: 1.1-1.5 s).
-  std::size_t blocking_capacity_;
   int thread_nice_;  ///< the mapping thread's nice value (Linux), 0 = the process's
   TimingRecorder* timings_;
 
