@@ -65,6 +65,8 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addInt("tracking.ba_global_every_keyframes", &c.ba_global_every_keyframes, 0, 1000000);
   schema.addInt("tracking.final_ba_window", &c.final_ba_window, 0, 1000000);
   schema.addInt("tracking.final_ba_max_iterations", &c.final_ba_max_iterations, 1, 500);
+  schema.addDouble("tracking.ba_acceleration_sigma_mps2", &c.ba_acceleration_sigma_mps2, 0.0, 1e6);
+  schema.addDouble("tracking.ba_acceleration_max_gap_s", &c.ba_acceleration_max_gap_s, 0.0, 1e3);
   schema.addBool("tracking.blend_reference_switches", &c.blend_reference_switches);
 
   schema.addInt("tracking.local_search_keyframes", &c.local_search_keyframes, 0, 1000);

@@ -74,6 +74,17 @@ TEST(RunCommand, WritesEveryOutputOnARealSequence) {
     return std::stod(json.substr(p + 9));
   };
   EXPECT_NEAR(rmse_at(eval.out), rmse_at(metrics), 1e-9);
+  // ... and its one-frame RPE (jitter) with `evaluate --rpe-delta 1 --rpe-unit f`.
+  const auto one_frame = runDynamap({"evaluate", "--gt", seq + "/groundtruth.txt", "--est",
+                                     (out / "trajectory.txt").string(), "--json", "--rpe-delta",
+                                     "1", "--rpe-unit", "f"});
+  ASSERT_EQ(one_frame.exit_code, 0) << one_frame.err;
+  const auto trans_rmse_at = [](const std::string& json, const std::string& section) {
+    const auto s = json.find("\"" + section + "\"");
+    const auto p = json.find("\"trans_rmse_m\":", s);
+    return std::stod(json.substr(p + 15));
+  };
+  EXPECT_NEAR(trans_rmse_at(one_frame.out, "rpe"), trans_rmse_at(metrics, "rpe_one_frame"), 1e-9);
 }
 
 TEST(RunCommand, ColourFramesWithoutDepthAreKeptOrDroppedAsConfigured) {

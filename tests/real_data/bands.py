@@ -48,6 +48,7 @@ CASES = {
 # metric: (where in the run's outputs, True if higher is better)
 METRICS = {
     "ate_cm": (("metrics", "ate", "rmse_m"), False),
+    "jitter_mm": (("metrics", "rpe_one_frame", "trans_rmse_m"), False),
     "lost_frames": (("frames", "lost"), False),
     "relocalized_frames": (("frames", "relocalized"), False),
     "mask_iou": (("metrics", "masks", "mean_iou"), True),
@@ -145,9 +146,12 @@ def read_metrics(out):
         for key in path:
             node = node.get(key) if isinstance(node, dict) else None
         if isinstance(node, (int, float)):
-            values[metric] = float(node) * (100.0 if metric == "ate_cm" else 1.0)
+            values[metric] = float(node) * UNITS.get(metric, 1.0)
     return values
 
+
+# Metrics in other units than the outputs' metres.
+UNITS = {"ate_cm": 100.0, "jitter_mm": 1000.0}
 
 # Shares and ratios: a limit beyond [0, 1] is no limit; it is kept there.
 SHARES = {"mask_iou", "mask_recall", "mask_precision", "standing_masked_share", "map_precision",

@@ -113,6 +113,11 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
       // leaves the roll about a short, straight path free (alignPoses()).
       alignment = alignPoses(gt, result.trajectory, TrajectoryEvalOptions{}.max_time_diff_s);
       metrics.update(Json::parse(evaluationToJson(*report.evaluation)));
+      // Jitter: the translation RPE over one frame (issue 48), beside the benchmark's 1 s RPE.
+      TrajectoryEvalOptions one_frame;
+      one_frame.rpe_delta = 1.0;
+      one_frame.rpe_unit = RpeDeltaUnit::kFrames;
+      metrics["rpe_one_frame"] = Json::parse(rpeToJson(computeRpe(gt, result.trajectory, one_frame)));
       TrajectoryPlotOptions plot;
       plot.title = "dynamap: " + fs::path(options.sequence_dir).filename().string();
       writeTrajectoryPlot(outPath(options, "trajectory.png"), gt, report.evaluation->ate, plot);

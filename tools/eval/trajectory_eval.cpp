@@ -278,16 +278,18 @@ std::string evaluationToJson(const TrajectoryEvaluation& evaluation) {
               {"max_m", a.error_m.max}};
   if (a.with_scale) ate["scale"] = a.alignment.scale;
   if (a.alignment_given) ate["alignment"] = "given";
-  const RpeResult& r = evaluation.rpe;
-  const Json rpe = {{"pairs", r.pairs},
-                    {"delta", r.delta},
-                    {"delta_unit", toString(r.unit)},
-                    {"trans_rmse_m", r.trans_m.rmse},
-                    {"trans_mean_m", r.trans_m.mean},
-                    {"trans_median_m", r.trans_m.median},
-                    {"rot_rmse_deg", r.rot_deg.rmse},
-                    {"rot_mean_deg", r.rot_deg.mean}};
-  return dumpJson(Json{{"ate", ate}, {"rpe", rpe}});
+  return dumpJson(Json{{"ate", ate}, {"rpe", Json::parse(rpeToJson(evaluation.rpe))}});
+}
+
+std::string rpeToJson(const RpeResult& r) {
+  return dumpJson(Json{{"pairs", r.pairs},
+                       {"delta", r.delta},
+                       {"delta_unit", toString(r.unit)},
+                       {"trans_rmse_m", r.trans_m.rmse},
+                       {"trans_mean_m", r.trans_m.mean},
+                       {"trans_median_m", r.trans_m.median},
+                       {"rot_rmse_deg", r.rot_deg.rmse},
+                       {"rot_mean_deg", r.rot_deg.mean}});
 }
 
 std::string evaluationToTable(const TrajectoryEvaluation& evaluation) {

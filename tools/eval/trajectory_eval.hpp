@@ -124,6 +124,8 @@ TrajectoryEvaluation evaluateTrajectories(const std::vector<TimedPose>& gt,
 
 /// {"ate": {...}, "rpe": {...}} on one line (keys as in `dynamap evaluate --json`).
 std::string evaluationToJson(const TrajectoryEvaluation& evaluation);
+/// {"pairs", "delta", "delta_unit", "trans_rmse_m", ...} of one RPE, on one line.
+std::string rpeToJson(const RpeResult& rpe);
 /// Human-readable table, several lines.
 std::string evaluationToTable(const TrajectoryEvaluation& evaluation);
 

@@ -1,12 +1,39 @@
 #include "dynamap/core/tracking/local_ba.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "dynamap/core/tracking/rgbd_residual.hpp"
 
 namespace dynamap {
 namespace {
 constexpr std::size_t kDenseSchurMaxPoses = 100;
+
+/// TrackerConfig::ba_acceleration_sigma_mps2: an acceleration prior on every three keyframes in
+/// a row in time, each close after the one before (a saved map's keyframes take no part).
+void addAccelerationPriors(const TrackerConfig& config, const BaWindow& window,
+                           std::vector<std::array<double, 6>>& poses, ceres::Problem& problem,
+                           ceres::LossFunction* loss) {
+  const std::vector<double>& t = window.timestamps_s;
+  if (config.ba_acceleration_sigma_mps2 <= 0.0 || t.size() != poses.size()) return;
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (std::isfinite(t[k])) order.push_back(k);
+  }
+  std::sort(order.begin(), order.end(), [&t](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+  const double max_gap = config.ba_acceleration_max_gap_s;
+  for (std::size_t i = 2; i < order.size(); ++i) {
+    const std::size_t a = order[i - 2], b = order[i - 1], c = order[i];
+    const double dt_ab = t[b] - t[a], dt_bc = t[c] - t[b];
+    if (dt_ab <= 0.0 || dt_bc <= 0.0 || dt_ab > max_gap || dt_bc > max_gap) continue;
+    if (window.fixed[a] && window.fixed[b] && window.fixed[c]) continue;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AccelerationResidual, 3, 6, 6, 6>(
+                                 new AccelerationResidual(dt_ab, dt_bc,
+                                                          config.ba_acceleration_sigma_mps2)),
+                             loss, poses[a].data(), poses[b].data(), poses[c].data());
+  }
+}
 }  // namespace
 
 bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& config,
@@ -35,6 +62,7 @@ bool solveBundleAdjustment(const PinholeCamera& camera, const TrackerConfig& con
     problem.AddResidualBlock(cost, &loss, poses[static_cast<std::size_t>(o.keyframe)].data(),
                              window.points[static_cast<std::size_t>(o.landmark)].data());
   }
+  addAccelerationPriors(config, window, poses, problem, &loss);
   bool any_free = false;
   for (std::size_t k = 0; k < poses.size(); ++k) {
     if (window.fixed[k]) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -187,6 +188,7 @@ BaWindow LocalMap::snapshotWindow(int window, int fixed, int older_covisible,
     w.keyframe_ids.push_back(kf.id);
     w.poses.push_back(kf.T_W_C);
     w.fixed.push_back(k < first_free || kf.loaded ? 1 : 0);  // a loaded map stays put
+    w.timestamps_s.push_back(kf.loaded ? std::numeric_limits<double>::quiet_NaN() : kf.timestamp_s);
   }
   return w;
 }

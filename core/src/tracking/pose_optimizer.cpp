@@ -35,18 +35,12 @@ struct MotionPriorResidual {
   MotionPriorResidual(const double* predicted, double inv_sigma_rad, double inv_sigma_m)
       : inv_sigma_rad_(inv_sigma_rad), inv_sigma_m_(inv_sigma_m) {
     for (int i = 0; i < 6; ++i) pred_[i] = predicted[i];
-    centre(pred_, centre_);
-  }
-  template <typename T>
-  static void centre(const T* p, T* c) {
-    const T neg_aa[3] = {-p[0], -p[1], -p[2]};
-    const T neg_t[3] = {-p[3], -p[4], -p[5]};
-    ceres::AngleAxisRotatePoint(neg_aa, neg_t, c);  // c = -R^T t
+    poseBlockCentre(pred_, centre_);
   }
   template <typename T>
   bool operator()(const T* p, T* r) const {
     T c[3];
-    centre(p, c);
+    poseBlockCentre(p, c);
     for (int i = 0; i < 3; ++i) {
       r[i] = (p[i] - T(pred_[i])) * T(inv_sigma_rad_);
       r[3 + i] = (c[i] - T(centre_[i])) * T(inv_sigma_m_);

@@ -160,6 +160,17 @@ struct TrackerConfig {
   /// 5 gave the same ATE (to 0.1 mm; Bonn x10 1.91 -> 1.82 cm) in half the time; 3 lost
   /// accuracy (Bonn x10 2.32 cm).
   int final_ba_max_iterations = 5;
+  /// Keyframes made close in time (a view movers fill makes one every frame) hold few static
+  /// points each, and bundle adjustment moves them apart (one-frame jumps of 1-2 cm on the Bonn
+  /// slice): three keyframes in a row, each at most ba_acceleration_max_gap_s after the one
+  /// before, get an acceleration prior on their camera centres (finite differences, in units of
+  /// this sigma, m/s^2, Huber-weighted). A hand-held camera's accelerations stay within a few
+  /// m/s^2 (the ground truths of teddy and the Bonn slice: at most 1.2 and 0.6 m/s^2 over
+  /// 0.1 s); one-frame jitter of 5 mm is ~9 m/s^2 at 30 Hz. 0 = off. At 5 (BENCHMARKS.md,
+  /// "Jitter"): one-frame translation RPE on the Bonn slice 6.80 -> 5.82 mm forward, 6.86 ->
+  /// 5.81 backward (12 starts each), ATE inside the noise of the means everywhere.
+  double ba_acceleration_sigma_mps2 = 5.0;
+  double ba_acceleration_max_gap_s = 0.25;
   /// The trajectory's frames take their reference keyframe's final pose; where the reference
   /// changes, the jump between the two keyframes' corrections is spread over the frames since
   /// the previous change (blendReferenceSwitches()), instead of each frame following its

@@ -33,6 +33,8 @@ struct BaWindow {
   std::vector<std::uint64_t> keyframe_ids;
   std::vector<Eigen::Isometry3d> poses;
   std::vector<std::uint8_t> fixed;
+  /// Of each keyframe; NaN for a saved map's (its clock is another run's).
+  std::vector<double> timestamps_s;
   std::vector<std::uint64_t> landmark_ids;
   std::vector<Eigen::Vector3d> points;
   std::vector<Observation> observations;

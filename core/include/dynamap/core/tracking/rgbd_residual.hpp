@@ -81,6 +81,33 @@ struct RgbdPoseOnlyResidual {
   Eigen::Vector3d p;
 };
 
+/// The camera centre c = -R^T t of a pose block T_C_W (angle-axis[3], translation[3]).
+template <typename T>
+void poseBlockCentre(const T* pose, T* c) {
+  const T neg_aa[3] = {-pose[0], -pose[1], -pose[2]};
+  const T neg_t[3] = {-pose[3], -pose[4], -pose[5]};
+  ceres::AngleAxisRotatePoint(neg_aa, neg_t, c);
+}
+
+/// Three poses in time order, dt_ab and dt_bc apart: their camera centres' acceleration
+/// (finite differences of the two velocities) over sigma (m/s^2), 3 residuals.
+struct AccelerationResidual {
+  AccelerationResidual(double dt_ab, double dt_bc, double sigma_mps2)
+      : dt_ab_(dt_ab), dt_bc_(dt_bc), scale_(1.0 / (0.5 * (dt_ab + dt_bc) * sigma_mps2)) {}
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* c, T* r) const {
+    T ca[3], cb[3], cc[3];
+    poseBlockCentre(a, ca);
+    poseBlockCentre(b, cb);
+    poseBlockCentre(c, cc);
+    for (int i = 0; i < 3; ++i) {
+      r[i] = ((cc[i] - cb[i]) / T(dt_bc_) - (cb[i] - ca[i]) / T(dt_ab_)) * T(scale_);
+    }
+    return true;
+  }
+  double dt_ab_, dt_bc_, scale_;
+};
+
 /// Isometry (camera -> world) <-> Ceres pose block T_C_W.
 inline void toPoseBlock(const Eigen::Isometry3d& T_W_C, double* block) {
   const Eigen::Isometry3d T_C_W = T_W_C.inverse();
