@@ -59,6 +59,8 @@ METRICS = {
     "map_completeness": (("metrics", "map", "completeness"), True),
     "map_ghost_ratio": (("metrics", "map", "ghost_ratio"), False),
 }
+# Metrics in other units than the outputs' metres.
+UNITS = {"ate_cm": 100.0, "jitter_mm": 1000.0}
 
 
 class DataMissing(Exception):
@@ -148,10 +150,6 @@ def read_metrics(out):
         if isinstance(node, (int, float)):
             values[metric] = float(node) * UNITS.get(metric, 1.0)
     return values
-
-
-# Metrics in other units than the outputs' metres.
-UNITS = {"ate_cm": 100.0, "jitter_mm": 1000.0}
 
 # Shares and ratios: a limit beyond [0, 1] is no limit; it is kept there.
 SHARES = {"mask_iou", "mask_recall", "mask_precision", "standing_masked_share", "map_precision",

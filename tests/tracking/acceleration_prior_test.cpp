@@ -44,7 +44,8 @@ void buildMap(const PinholeCamera& camera, const Scene& scene, double gap_s, Loc
     for (int i = 0; i < scene.points_per_keyframe; ++i) {
       const Eigen::Vector3d p_W = truePose(k) * Eigen::Vector3d(ux(rng), uy(rng), uz(rng));
       const std::uint64_t id = map.addLandmark(p_W + Eigen::Vector3d(0.0, 0.0, z_noise(rng)), {});
-      for (int j = k; j < std::min(kKeyframes, k + scene.track_length); ++j) seen[j].emplace_back(id, p_W);
+      for (int j = k; j < std::min(kKeyframes, k + scene.track_length); ++j)
+        seen[j].emplace_back(id, p_W);
     }
   }
   for (int k = 0; k < kKeyframes; ++k) {
@@ -83,7 +84,8 @@ Solved solve(const Scene& scene, double sigma_mps2, double gap_s = kFrameS) {
     s.rms_error_m += err[k].squaredNorm() / kKeyframes;
   }
   for (std::size_t k = 2; k < err.size(); ++k) {
-    s.rms_second_diff_m += (err[k] - 2.0 * err[k - 1] + err[k - 2]).squaredNorm() / (kKeyframes - 2);
+    s.rms_second_diff_m +=
+        (err[k] - 2.0 * err[k - 1] + err[k - 2]).squaredNorm() / (kKeyframes - 2);
   }
   s.rms_error_m = std::sqrt(s.rms_error_m);
   s.rms_second_diff_m = std::sqrt(s.rms_second_diff_m);

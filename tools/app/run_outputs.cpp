@@ -117,7 +117,8 @@ RunReport writeRunOutputs(const RunOptions& options, const TumSequence& sequence
       TrajectoryEvalOptions one_frame;
       one_frame.rpe_delta = 1.0;
       one_frame.rpe_unit = RpeDeltaUnit::kFrames;
-      metrics["rpe_one_frame"] = Json::parse(rpeToJson(computeRpe(gt, result.trajectory, one_frame)));
+      metrics["rpe_one_frame"] =
+          Json::parse(rpeToJson(computeRpe(gt, result.trajectory, one_frame)));
       TrajectoryPlotOptions plot;
       plot.title = "dynamap: " + fs::path(options.sequence_dir).filename().string();
       writeTrajectoryPlot(outPath(options, "trajectory.png"), gt, report.evaluation->ate, plot);

@@ -83,6 +83,17 @@ std::string formatRow(const char* name, double value, const char* unit) {
   return buffer;
 }
 
+Json rpeJsonOf(const RpeResult& r) {
+  return Json{{"pairs", r.pairs},
+              {"delta", r.delta},
+              {"delta_unit", toString(r.unit)},
+              {"trans_rmse_m", r.trans_m.rmse},
+              {"trans_mean_m", r.trans_m.mean},
+              {"trans_median_m", r.trans_m.median},
+              {"rot_rmse_deg", r.rot_deg.rmse},
+              {"rot_mean_deg", r.rot_deg.mean}};
+}
+
 }  // namespace
 
 const char* toString(AlignmentKind kind) { return kind == AlignmentKind::kSim3 ? "sim3" : "se3"; }
@@ -278,19 +289,10 @@ std::string evaluationToJson(const TrajectoryEvaluation& evaluation) {
               {"max_m", a.error_m.max}};
   if (a.with_scale) ate["scale"] = a.alignment.scale;
   if (a.alignment_given) ate["alignment"] = "given";
-  return dumpJson(Json{{"ate", ate}, {"rpe", Json::parse(rpeToJson(evaluation.rpe))}});
+  return dumpJson(Json{{"ate", ate}, {"rpe", rpeJsonOf(evaluation.rpe)}});
 }
 
-std::string rpeToJson(const RpeResult& r) {
-  return dumpJson(Json{{"pairs", r.pairs},
-                       {"delta", r.delta},
-                       {"delta_unit", toString(r.unit)},
-                       {"trans_rmse_m", r.trans_m.rmse},
-                       {"trans_mean_m", r.trans_m.mean},
-                       {"trans_median_m", r.trans_m.median},
-                       {"rot_rmse_deg", r.rot_deg.rmse},
-                       {"rot_mean_deg", r.rot_deg.mean}});
-}
+std::string rpeToJson(const RpeResult& rpe) { return dumpJson(rpeJsonOf(rpe)); }
 
 std::string evaluationToTable(const TrajectoryEvaluation& evaluation) {
   const AteResult& a = evaluation.ate;

@@ -28,10 +28,10 @@ void addAccelerationPriors(const TrackerConfig& config, const BaWindow& window,
     const double dt_ab = t[b] - t[a], dt_bc = t[c] - t[b];
     if (dt_ab <= 0.0 || dt_bc <= 0.0 || dt_ab > max_gap || dt_bc > max_gap) continue;
     if (window.fixed[a] && window.fixed[b] && window.fixed[c]) continue;
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<AccelerationResidual, 3, 6, 6, 6>(
-                                 new AccelerationResidual(dt_ab, dt_bc,
-                                                          config.ba_acceleration_sigma_mps2)),
-                             loss, poses[a].data(), poses[b].data(), poses[c].data());
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<AccelerationResidual, 3, 6, 6, 6>(
+            new AccelerationResidual(dt_ab, dt_bc, config.ba_acceleration_sigma_mps2)),
+        loss, poses[a].data(), poses[b].data(), poses[c].data());
   }
 }
 }  // namespace
