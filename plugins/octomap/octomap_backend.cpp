@@ -1,11 +1,12 @@
 // `octomap`: occupancy octree with ray casting from the camera centre (free space clears
 // ghosts). Fast path: each keyframe's points are reduced to the centres of the distinct voxels
-// they hit before ray casting (lazy evaluation; inner nodes are updated at export). The ray
-// casting of a keyframe runs on another thread while the previous keyframe's cells are updated
-// in the tree, in keyframe order (the same updates as insertPointCloud, the same map).
+// they hit before ray casting (lazy evaluation; inner nodes are updated at export). The rays of
+// the newest two keyframes are cast on threads of their own while an older keyframe's cells are
+// updated in the tree, in keyframe order (the same updates as insertPointCloud, the same map).
 // Exports map.bt, map.ot, grid.pgm + grid.yaml and cloud.ply (occupied voxel centres). A saved
 // map's map.ot (importMap()) is the tree's start, to which each rebuild's reset() returns.
 #include <cmath>
+#include <deque>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -81,7 +82,8 @@ class OctomapBackend final : public MapBackend {
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
   bool fusesViews() const override { return true; }
   void reset() override {
-    if (pending_.valid()) pending_.get();
+    for (auto& cast : pending_) cast.get();
+    pending_.clear();
     tree_ = loaded_ ? std::make_unique<octomap::OcTree>(*loaded_)
                     : std::make_unique<octomap::OcTree>(resolution_m_);
     configure(*tree_);
@@ -129,23 +131,26 @@ class OctomapBackend final : public MapBackend {
   struct Cells : plugin::RayCells {
     int sign = +1;  ///< -1: a keyframe taken out
   };
-  /// The view's points reduced to distinct voxel centres (discretize_), its rays cast on another
-  /// thread, the previous view's cells written into the tree meanwhile, each with `sign`.
+  /// The view's points reduced to distinct voxel centres (discretize_), its rays cast on a thread
+  /// of its own (each with `sign`); with more than kCastsInFlight casts under way, the oldest's
+  /// cells are written into the tree meanwhile (a rebuild keeps both cores casting).
   void castAndApply(const KeyframeView& view, int sign) {
     octomap::Pointcloud cloud = worldCloud(view);
-    // The caster is free once the previous keyframe's rays are in; its cells go into the tree
-    // while this keyframe's rays are cast.
-    std::unique_ptr<Cells> previous = pending_.valid() ? pending_.get() : nullptr;
-    pending_ = std::async(std::launch::async, [this, sign, cloud = std::move(cloud),
-                                               origin = originOf(view)] {
-      auto cells = std::make_unique<Cells>();
-      static_cast<plugin::RayCells&>(*cells) =
-          plugin::castRays(caster_, cloud, origin, max_range_m_);
-      cells->sign = sign;
-      return cells;
-    });
-    if (previous) apply(*previous);
+    pending_.push_back(std::async(std::launch::async,
+                                  [this, sign, cloud = std::move(cloud), origin = originOf(view)] {
+                                    auto cells = std::make_unique<Cells>();
+                                    static_cast<plugin::RayCells&>(*cells) =
+                                        plugin::castRays(caster_, cloud, origin, max_range_m_);
+                                    cells->sign = sign;
+                                    return cells;
+                                  }));
+    while (pending_.size() > kCastsInFlight) applyOldestCast();
     dirty_inner_ = true;
+  }
+  void applyOldestCast() const {
+    const std::unique_ptr<Cells> cells = pending_.front().get();
+    pending_.pop_front();
+    apply(*cells);
   }
   /// The view's points in the world frame (reduced to distinct voxel centres: discretize_).
   octomap::Pointcloud worldCloud(const KeyframeView& view) const {
@@ -219,7 +224,7 @@ class OctomapBackend final : public MapBackend {
     return children > 1;
   }
   void drain() const {
-    if (pending_.valid()) apply(*pending_.get());
+    while (!pending_.empty()) applyOldestCast();
   }
   void finalizeTree() {
     drain();
@@ -245,11 +250,12 @@ class OctomapBackend final : public MapBackend {
     return out;
   }
 
-  // The last keyframe's cells are applied when the map is next read, by const readers too.
+  static constexpr std::size_t kCastsInFlight = 2;
+  // The last keyframes' cells are applied when the map is next read, by const readers too.
   std::unique_ptr<octomap::OcTree> tree_;
   std::unique_ptr<const octomap::OcTree> loaded_;  ///< importMap()'s tree, of no keyframe
   octomap::OcTree caster_;  ///< the key grid and ray traversal of the casting thread; no map
-  mutable std::future<std::unique_ptr<Cells>> pending_;
+  mutable std::deque<std::future<std::unique_ptr<Cells>>> pending_;  ///< oldest first
   double resolution_m_ = kDefaultResolutionM;
   double prob_hit_ = 0.7, prob_miss_ = 0.4, clamp_min_ = 0.12, clamp_max_ = 0.97;
   double max_range_m_ = -1.0;

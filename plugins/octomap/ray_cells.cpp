@@ -17,6 +17,29 @@ void addOnce(const octomap::OcTreeKey& key, FlatIndex& seen, std::vector<octomap
   if (seen.tryEmplace(packed(key), 0).second) out.push_back(key);
 }
 
+/// The key's bits interleaved (a Morton code): keys in this order walk the octree depth first,
+/// so that consecutive updates share most of their path from the root.
+std::uint64_t mortonCode(const octomap::OcTreeKey& k) {
+  const auto spread = [](std::uint64_t x) {  // 16 bits to every third bit
+    x &= 0xFFFF;
+    x = (x | x << 16) & 0x0000FF0000FFull;
+    x = (x | x << 8) & 0x00F00F00F00Full;
+    x = (x | x << 4) & 0x0C30C30C30C3ull;
+    x = (x | x << 2) & 0x249249249249ull;
+    return x;
+  };
+  return spread(k[0]) | spread(k[1]) << 1 | spread(k[2]) << 2;
+}
+
+void sortByMortonCode(std::vector<octomap::OcTreeKey>& keys) {
+  std::vector<std::pair<std::uint64_t, octomap::OcTreeKey>> coded;
+  coded.reserve(keys.size());
+  for (const octomap::OcTreeKey& k : keys) coded.emplace_back(mortonCode(k), k);
+  std::sort(coded.begin(), coded.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = coded[i].second;
+}
+
 }  // namespace
 
 RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
@@ -41,6 +64,8 @@ RayCells castRays(const octomap::OcTree& tree, const octomap::Pointcloud& scan,
     if (occupied_seen.find(packed(key)) == FlatIndex::kMissing) cells.free[kept++] = key;
   }
   cells.free.resize(kept);
+  sortByMortonCode(cells.free);
+  sortByMortonCode(cells.occupied);
   return cells;
 }
 

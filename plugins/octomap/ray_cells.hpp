@@ -2,17 +2,19 @@
 
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <octomap/OcTree.h>
+#include <Eigen/Geometry>
 
 namespace dynamap::plugin {
 
 /// The cells one scan updates, as OctoMap's OccupancyOcTreeBase::computeUpdate() finds them:
 /// free, the cells its rays cross (cut at `max_range_m` when that is >= 0); occupied, the end
-/// points' within that range; a cell in both is occupied only. Each cell once, in the order
-/// first met (deterministic). The sets are flat hash tables, not OctoMap's node-based
-/// unordered_set of keys, whose allocations, rehashing and freeing took a third of a keyframe's
-/// integration.
+/// points' within that range; a cell in both is occupied only. Each cell once, in the Morton
+/// order of the keys (deterministic; the octree's depth-first order, so that updates one after
+/// the other share most of their path from the root: a third less time in the tree's updates on
+/// the Bonn slice x10, the same map, as each cell gets one update per scan). Collected in flat
+/// hash tables, not OctoMap's node-based unordered_set of keys, whose allocations, rehashing and
+/// freeing took a third of a keyframe's integration.
 struct RayCells {
   std::vector<octomap::OcTreeKey> free, occupied;
 };
