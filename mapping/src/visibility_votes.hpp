@@ -48,8 +48,8 @@ inline bool briefUnderMask(const Element& e, const VisibilityOptions& options,
 }
 
 /// The beside-a-mover rule (options.mask_near_px, mask_near_depth_m): an element that a single
-/// keyframe saw, unmasked, seen briefly, and that a keyframe within options.mask_span_s saw with
-/// moving blocks near its projection and near its depth.
+/// keyframe (up to options.mask_near_max_views) saw, unmasked, seen briefly, and that a keyframe
+/// within options.mask_span_s saw with moving blocks near its projection and near its depth.
 class BesideMover {
  public:
   BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
@@ -61,7 +61,8 @@ class BesideMover {
   }
 
   bool holds(const Element& e, const Eigen::Vector3f& centroid) const {
-    if (T_C_W_.empty() || e.observed != 1 || e.masked != 0 || !seenBriefly(e, options_, stamps_))
+    if (T_C_W_.empty() || e.observed > options_.mask_near_max_views || e.masked != 0 ||
+        !seenBriefly(e, options_, stamps_))
       return false;
     const double t = stamps_[e.first];
     std::size_t j = e.first;  // the keyframes within mask_span_s of the one that saw it

@@ -1,8 +1,11 @@
-// The octomap backend casts one keyframe's rays on another thread while it writes the previous
-// keyframe's cells into its tree: the map must be exactly OctoMap's own insertPointCloud's.
+// The octomap backend casts keyframes' rays on other threads while it writes earlier keyframes'
+// cells into its tree (in Morton order): the map must be exactly OctoMap's own
+// insertPointCloud's.
 #ifdef DYNAMAP_TEST_WITH_OCTOMAP
 
+#include <cmath>
 #include <filesystem>
+#include <memory>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
@@ -56,6 +59,22 @@ TEST(OctomapBackend, PipelinedRayCastingGivesInsertPointCloudsMap) {
   const fs::path dir = fs::temp_directory_path() / "dynamap_octomap_pipeline";
   fs::remove_all(dir);
   backend->exportMap(dir.string());
+  // map.ot holds the log-odds: each of the reference's leaves (a pruned one for all its cells)
+  // has the same value in the backend's tree, to float rounding.
+  {
+    std::unique_ptr<octomap::AbstractOcTree> read(
+        octomap::AbstractOcTree::read((dir / "map.ot").string()));
+    const auto* with_log_odds = dynamic_cast<const octomap::OcTree*>(read.get());
+    ASSERT_NE(with_log_odds, nullptr);
+    std::size_t leaves = 0, differ = 0;
+    for (auto it = reference.begin_leafs(), end = reference.end_leafs(); it != end; ++it) {
+      const octomap::OcTreeNode* node = with_log_odds->search(it.getKey());
+      ++leaves;
+      differ += node == nullptr || std::fabs(node->getLogOdds() - it->getLogOdds()) > 1e-6f;
+    }
+    EXPECT_GT(leaves, 1000u);
+    EXPECT_EQ(differ, 0u) << "of " << leaves;
+  }
   octomap::OcTree exported(res);
   ASSERT_TRUE(exported.readBinary((dir / "map.bt").string()));
   reference.toMaxLikelihood();

@@ -36,6 +36,9 @@ struct VisibilityOptions {
   /// voxels around them.
   int mask_near_px = 24;
   double mask_near_depth_m = 0.3;
+  /// The rule's "a single keyframe": up to this many (a mover seen by the first keyframes of a
+  /// run before anything found it moving, and hidden behind itself afterwards).
+  int mask_near_max_views = 1;
   /// The dynamic mask is grown by this radius (px) before its blocks are judged: the margin
   /// that a keyframe's mask keeps off the background (mapping.mask_margin_behind_m) still
   /// counts for the votes of what lies at a mover's outline.
