@@ -136,16 +136,17 @@ class OctomapBackend final : public MapBackend {
   /// cells are written into the tree meanwhile (a rebuild keeps both cores casting).
   void castAndApply(const KeyframeView& view, int sign) {
     octomap::Pointcloud cloud = worldCloud(view);
-    pending_.push_back(std::async(std::launch::async,
-                                  [this, sign, cloud = std::move(cloud), origin = originOf(view)] {
-                                    auto cells = std::make_unique<Cells>();
-                                    static_cast<plugin::RayCells&>(*cells) =
-                                        plugin::castRays(caster_, cloud, origin, max_range_m_);
-                                    cells->sign = sign;
-                                    return cells;
-                                  }));
+    pending_.push_back(std::async(std::launch::async, &OctomapBackend::castCells, this,
+                                  std::move(cloud), originOf(view), sign));
     while (pending_.size() > kCastsInFlight) applyOldestCast();
     dirty_inner_ = true;
+  }
+  std::unique_ptr<Cells> castCells(const octomap::Pointcloud& cloud, octomap::point3d origin,
+                                   int sign) const {
+    auto cells = std::make_unique<Cells>();
+    static_cast<plugin::RayCells&>(*cells) = plugin::castRays(caster_, cloud, origin, max_range_m_);
+    cells->sign = sign;
+    return cells;
   }
   void applyOldestCast() const {
     const std::unique_ptr<Cells> cells = pending_.front().get();
