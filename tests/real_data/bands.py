@@ -3,8 +3,9 @@
 
   bands.py check CASE --dynamap BIN [--work DIR] [--set KEY=VALUE ...]
                                                       run one case, compare with bands.json
-  bands.py measure --dynamap BIN [BIN ...] [--cases A,B] [--work DIR]
+  bands.py measure --dynamap BIN [BIN ...] [--cases A,B] [--metrics M,N] [--work DIR]
                                                       run every case's variants, write bands.json
+                                                      (--metrics: only those metrics' bands)
   bands.py sweep --dynamap BIN [--cases A,B] [--set KEY=VALUE ...]
                                                       run each case from every start frame of
                                                       `measure`, print each run and the means
@@ -220,7 +221,12 @@ def measure(args):
                 print("%s build %d start %d: %s" % (case, b, start, json.dumps(values)), flush=True)
                 for metric, value in values.items():
                     samples.setdefault(metric, []).append(value)
-        result["cases"][case] = {metric: entry_of(metric, s) for metric, s in samples.items()}
+        entries = {metric: entry_of(metric, s) for metric, s in samples.items()
+                   if args.metrics is None or metric in args.metrics.split(",")}
+        if args.metrics is None:
+            result["cases"][case] = entries
+        else:  # only these metrics' bands change
+            result["cases"].setdefault(case, {}).update(entries)
     commit = subprocess.run(["git", "-C", SOURCE, "describe", "--always", "--dirty"],
                             stdout=subprocess.PIPE, text=True).stdout.strip()
     result["how_measured"] = {
@@ -229,14 +235,20 @@ def measure(args):
                   "deviations of the samples, never tighter than the worst sample; better than "
                   "the band always passes" % (STARTS, len(args.dynamap), SIGMAS),
         "builds": args.builds or ["build %d" % i for i in range(len(args.dynamap))],
-        "command": "tests/real_data/bands.py measure --dynamap " + " ".join(args.dynamap),
+        "command": "tests/real_data/bands.py measure --dynamap " + " ".join(args.dynamap) +
+                   ("" if args.cases is None else " --cases " + args.cases) +
+                   ("" if args.metrics is None else " --metrics " + args.metrics),
         "commit": commit,
         "date": datetime.datetime.now(datetime.timezone.utc).date().isoformat(),
         "machine": "%s, %d cores" % (cpu_model(), os.cpu_count()),
     }
     for case in cases:  # the cases not measured now keep theirs
-        result.setdefault("measured_at", {})[case] = {
-            k: result["how_measured"][k] for k in ("commit", "date", "machine", "builds")}
+        when = {k: result["how_measured"][k] for k in ("commit", "date", "machine", "builds")}
+        if args.metrics is None:
+            result.setdefault("measured_at", {})[case] = when
+        else:  # the case's other metrics keep theirs
+            result.setdefault("measured_at", {}).setdefault(case, {})[
+                "metrics " + args.metrics] = when
     write_bands(result)
     return 0
 
@@ -314,6 +326,8 @@ def main():
     parser.add_argument("--dynamap", nargs="+", default=[os.path.join(SOURCE, "build/bin/dynamap")])
     parser.add_argument("--builds", nargs="*", help="names of the --dynamap builds (measure)")
     parser.add_argument("--cases", help="comma list (measure, sweep; default all)")
+    parser.add_argument("--metrics", help="comma list: measure only these metrics' bands "
+                        "(the others keep theirs; default all)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="a configuration override for the runs (check, sweep)")
     parser.add_argument("--work", default="/tmp/dynamap_real_data")
