@@ -152,6 +152,7 @@ def read_metrics(out):
             values[metric] = float(node) * UNITS.get(metric, 1.0)
     return values
 
+
 # Shares and ratios: a limit beyond [0, 1] is no limit; it is kept there.
 SHARES = {"mask_iou", "mask_recall", "mask_precision", "standing_masked_share", "map_precision",
           "map_completeness", "map_ghost_ratio"}
@@ -211,6 +212,7 @@ def check(args):
 
 def measure(args):
     cases = args.cases.split(",") if args.cases else list(CASES)
+    only = set(args.metrics.split(",")) if args.metrics else None  # None: every metric
     result = load_bands() if os.path.isfile(BANDS_FILE) else {"cases": {}}
     for case in cases:
         samples = {}
@@ -222,8 +224,8 @@ def measure(args):
                 for metric, value in values.items():
                     samples.setdefault(metric, []).append(value)
         entries = {metric: entry_of(metric, s) for metric, s in samples.items()
-                   if args.metrics is None or metric in args.metrics.split(",")}
-        if args.metrics is None:
+                   if only is None or metric in only}
+        if only is None:
             result["cases"][case] = entries
         else:  # only these metrics' bands change
             result["cases"].setdefault(case, {}).update(entries)
@@ -244,7 +246,7 @@ def measure(args):
     }
     for case in cases:  # the cases not measured now keep theirs
         when = {k: result["how_measured"][k] for k in ("commit", "date", "machine", "builds")}
-        if args.metrics is None:
+        if only is None:
             result.setdefault("measured_at", {})[case] = when
         else:  # the case's other metrics keep theirs
             result.setdefault("measured_at", {}).setdefault(case, {})[
