@@ -124,6 +124,42 @@ TEST(MapMetrics, GhostFragmentsAreConnectedGroupsOfAtLeast50Points) {
   EXPECT_EQ(connectedGroups(sheet, 0.01, 50), std::vector<std::size_t>{900});
 }
 
+// A mover that stopped: the dynamic reference holds its path (z = 0.5, x < 0.5) and the place
+// where it stands (z = 0.5, x >= 0.5), the settled reference only the place.
+TEST(MapMetrics, SettledMoverCountsAsKeptNotAsPathGhost) {
+  auto refs = makeRefs(planeZ(0.0f, 0.01f), planeZ(0.5f, 0.01f));
+  for (const auto& p : planeZ(0.5f, 0.01f))
+    if (p.x() >= 0.5f) refs.settled_points.push_back(p);
+  refs.settled_ref = std::make_shared<PointIndex>(refs.settled_points);
+  const auto patch = [](float x0, float x1) {  // the ghost plane between x0 and x1
+    std::vector<Eigen::Vector3f> out;
+    for (const auto& p : planeZ(0.5f, 0.01f))
+      if (p.x() >= x0 && p.x() < x1) out.push_back(p);
+    return out;
+  };
+  std::vector<Eigen::Vector3f> kept = planeZ(0.0f, 0.01f);
+  for (const auto& p : patch(0.5f, 1.0f)) kept.push_back(p);
+  const MapMetrics at_place = computeMapMetrics(kept, refs);
+  EXPECT_NEAR(at_place.ghost_ratio, 1.0 / 3.0, 0.02);  // the shared definition counts it
+  EXPECT_NEAR(at_place.path_ghost_ratio, 0.0, 1e-9);
+  EXPECT_NEAR(at_place.settled_completeness, 1.0, 1e-9);
+
+  // The first half of its path (x < 0.25, 25 cm from the place) in the map, its place not.
+  std::vector<Eigen::Vector3f> path = planeZ(0.0f, 0.01f);
+  const std::size_t n_static = path.size();
+  for (const auto& p : patch(0.0f, 0.25f)) path.push_back(p);
+  const MapMetrics on_path = computeMapMetrics(path, refs);
+  EXPECT_NEAR(on_path.path_ghost_ratio, on_path.ghost_ratio, 1e-9);
+  EXPECT_NEAR(on_path.path_ghost_ratio, 1.0 - static_cast<double>(n_static) / path.size(), 0.01);
+  EXPECT_NEAR(on_path.settled_completeness, 0.0, 1e-9);
+
+  // Without a settled reference both stay 0.
+  const MapMetrics plain =
+      computeMapMetrics(path, makeRefs(planeZ(0.0f, 0.01f), planeZ(0.5f, 0.01f)));
+  EXPECT_EQ(plain.path_ghost_ratio, 0.0);
+  EXPECT_EQ(plain.settled_completeness, 0.0);
+}
+
 TEST(PlyIo, ReadsAsciiAndBinaryWithExtraProperties) {
   const auto dir = freshTempDir("ply_io");
   const std::string ascii = (dir / "a.ply").string();

@@ -7,7 +7,10 @@ usage: make_movers.py sprites OUT_SPRITES          cut the object sprites from t
 A walker with "stop_at_s" (seconds from the first frame) moves along its path until then and
 stands at that place from then on, facing where the camera was when it stopped; from
 "stop_at_s" + "settle_s" (default 0.5) its pixels are labelled 128 (static) in mask/, as a
-standing person's are. Everything else is ../shared/tools/dyndata/make_dynamic_sequence.py.
+standing person's are, and their clean geometry goes to reference_settled.ply (1 cm voxels): the
+place where it stands, which the map should hold (the generator's reference_static.ply is the
+room without it, and its reference_dynamic.ply holds the place too, from the frames before it
+settled). Everything else is ../shared/tools/dyndata/make_dynamic_sequence.py.
 """
 import os, subprocess, sys
 import numpy as np
@@ -50,12 +53,32 @@ def add_stops(g):
     g.Walker.geometry = stopping_geometry
 
 
+def gather_settled(g):
+    """Patch the generator's render: the colour frames' pixels labelled static (settled movers)
+    go, as clean geometry, into the returned accumulator."""
+    render, settled = g.render, g.VoxelAccumulator(0.01)
+
+    def render_gathering(sc, walkers, t, T, d_src, rgb=None):
+        out = render(sc, walkers, t, T, d_src, rgb)
+        if rgb is not None:
+            _, mask, zper = out
+            settled.add(g.backproject(np.where(mask == g.STATIC, zper, 0), T))
+        return out
+
+    g.render = render_gathering
+    return settled
+
+
 def make_scene(args):
     sys.path.insert(0, TOOLS)
     import make_dynamic_sequence as g
     add_stops(g)
+    settled = gather_settled(g)
     sys.argv = ['make_dynamic_sequence.py'] + args
     g.main()
+    points = settled.result()
+    if len(points):
+        g.write_ply(os.path.join(args[-1], 'reference_settled.ply'), points)
 
 
 if __name__ == '__main__':

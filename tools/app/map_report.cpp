@@ -21,15 +21,19 @@ std::string mapMetricsJson(const std::string& sequence_dir, const std::string& m
   T_ref_map.linear() = alignment.scale * alignment.R;  // scale is 1 for a rigid alignment
   T_ref_map.translation() = alignment.t;
   const MapMetrics m = computeMapMetrics(readPlyVertices(map_file.string()), refs, T_ref_map);
-  const Json json = {{"file", map_file.filename().string()},
-                     {"map_points_1cm", m.map_points},
-                     {"accuracy_mean_m", m.accuracy_mean_m},
-                     {"precision", m.precision},
-                     {"completeness", m.completeness},
-                     {"fscore", m.fscore},
-                     {"ghost_ratio", m.ghost_ratio},
-                     {"ghost_fragments", m.ghost_fragments},
-                     {"ghost_fragment_points", m.ghost_fragment_points}};
+  Json json = {{"file", map_file.filename().string()},
+               {"map_points_1cm", m.map_points},
+               {"accuracy_mean_m", m.accuracy_mean_m},
+               {"precision", m.precision},
+               {"completeness", m.completeness},
+               {"fscore", m.fscore},
+               {"ghost_ratio", m.ghost_ratio},
+               {"ghost_fragments", m.ghost_fragments},
+               {"ghost_fragment_points", m.ghost_fragment_points}};
+  if (!refs.settled_points.empty()) {
+    json["path_ghost_ratio"] = m.path_ghost_ratio;
+    json["settled_completeness"] = m.settled_completeness;
+  }
   return dumpJson(json);
 }
 

@@ -40,6 +40,30 @@ std::uint64_t voxelKey(const Eigen::Vector3f& p, double inv, Eigen::Vector3i* ce
   return packCell(c);
 }
 
+// The ghosts off the settled reference, and its points the map covers (MapMetrics).
+void addSettledMetrics(const std::vector<Eigen::Vector3f>& map,
+                       const std::vector<Eigen::Vector3f>& ghost_points,
+                       const ReferenceClouds& refs, const MapMetricsOptions& options,
+                       MapMetrics* m) {
+  if (!refs.settled_ref || refs.settled_points.empty() || map.empty()) return;
+  const auto ghost_thr = static_cast<float>(options.ghost_dynamic_m);
+  std::vector<char> on_path(ghost_points.size(), 0);
+  parallelFor(ghost_points.size(), [&](std::size_t i) {
+    on_path[i] = refs.settled_ref->nearestDistance(ghost_points[i], ghost_thr) > ghost_thr ? 1 : 0;
+  });
+  const PointIndex map_index(map);
+  const auto thr = static_cast<float>(options.threshold_m);
+  std::vector<char> covered(refs.settled_points.size(), 0);
+  parallelFor(refs.settled_points.size(), [&](std::size_t i) {
+    covered[i] = map_index.nearestDistance(refs.settled_points[i], thr) <= thr ? 1 : 0;
+  });
+  std::size_t path = 0, n_covered = 0;
+  for (const char c : on_path) path += c;
+  for (const char c : covered) n_covered += c;
+  m->path_ghost_ratio = static_cast<double>(path) / map.size();
+  m->settled_completeness = static_cast<double>(n_covered) / refs.settled_points.size();
+}
+
 }  // namespace
 
 PointIndex::PointIndex(std::vector<Eigen::Vector3f> points) : points_(std::move(points)) {
@@ -177,6 +201,11 @@ ReferenceClouds loadReferenceClouds(const std::string& dir) {
   const fs::path dyn = fs::path(dir) / "reference_dynamic.ply";
   if (fs::exists(dyn))
     refs.dynamic_ref = std::make_shared<PointIndex>(readPlyVertices(dyn.string()));
+  const fs::path settled = fs::path(dir) / "reference_settled.ply";
+  if (fs::exists(settled)) {
+    refs.settled_points = readPlyVertices(settled.string());
+    refs.settled_ref = std::make_shared<PointIndex>(refs.settled_points);
+  }
   return refs;
 }
 
@@ -231,6 +260,7 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
     ++m.ghost_fragments;
     m.ghost_fragment_points += n;
   }
+  addSettledMetrics(map, ghost_points, refs, options, &m);
   if (!options.completeness) return m;
   const PointIndex map_index(map);
   std::vector<char> covered(refs.static_points.size(), 0);

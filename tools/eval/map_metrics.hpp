@@ -40,8 +40,13 @@ struct ReferenceClouds {
   std::shared_ptr<const PointIndex> static_coarse;
   static constexpr double kCoarseVoxelM = 0.05;
   std::vector<Eigen::Vector3f> static_points;  ///< for completeness
+  /// reference_settled.ply (tests/movers/make_movers.py; may be empty): where a mover stands
+  /// after it stopped. It belongs in the map, though reference_dynamic.ply holds that place too.
+  std::vector<Eigen::Vector3f> settled_points;
+  std::shared_ptr<const PointIndex> settled_ref;
 };
-/// Reads <dir>/reference_static.ply and <dir>/reference_dynamic.ply (if present).
+/// Reads <dir>/reference_static.ply, and reference_dynamic.ply and reference_settled.ply if
+/// present.
 ReferenceClouds loadReferenceClouds(const std::string& dir);
 
 struct MapMetrics {
@@ -55,6 +60,11 @@ struct MapMetrics {
   /// MapMetricsOptions::ghost_fragment_min_points ghost points, and the points in them.
   std::size_t ghost_fragments = 0;
   std::size_t ghost_fragment_points = 0;
+  /// With a settled reference (else 0): the ghosts farther than ghost_dynamic_m from it (where
+  /// movers only passed), and the share of its points with a map point within threshold_m (the
+  /// stopped mover kept where it stands).
+  double path_ghost_ratio = 0.0;
+  double settled_completeness = 0.0;
 };
 
 struct MapMetricsOptions {
