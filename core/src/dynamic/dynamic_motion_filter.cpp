@@ -302,8 +302,8 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
   const auto start = Clock::now();
   std::vector<Detection> people = dets;  // and last frame's, also those carried undetected
   people.insert(people.end(), prev_people_.begin(), prev_people_.end());
-  const cv::Mat exclude =
-      notMovers(depth_m.size(), prev_kept_movers_, evidence.planes, people, classes_);
+  const cv::Mat exclude = notMovers(depth_m, prev_kept_movers_, evidence.planes, people, classes_,
+                                    config_.depth_band_m);
   const std::vector<Detection> movers = moverDetections(depth_m, evidence.T_W_C, evidence.K, *view,
                                                         exclude, seenThroughOptions(config_));
   dets.insert(dets.end(), movers.begin(), movers.end());

@@ -2,7 +2,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/core/dynamic/object_pixels.hpp"
+
 namespace dynamap {
+namespace {
+constexpr int kPersonMarginPx = 5;  ///< notMovers(): around a person's own pixels
+}  // namespace
 
 std::vector<Detection> moverDetections(const cv::Mat& depth_m, const cv::Matx44d& T_W_C,
                                        const cv::Vec4d& K, const DepthView& view,
@@ -26,13 +31,26 @@ std::vector<Detection> moverDetections(const cv::Mat& depth_m, const cv::Matx44d
   return out;
 }
 
-cv::Mat notMovers(const cv::Size& size, const cv::Mat& kept_movers, const cv::Mat& planes,
-                  const std::vector<Detection>& detections, const ClassTable& classes) {
+cv::Mat notMovers(const cv::Mat& depth_m, const cv::Mat& kept_movers, const cv::Mat& planes,
+                  const std::vector<Detection>& detections, const ClassTable& classes,
+                  double band_m) {
+  const cv::Size size = depth_m.size();
   cv::Mat out = kept_movers.empty() ? cv::Mat::zeros(size, CV_8UC1) : kept_movers.clone();
   if (!planes.empty()) out |= planes;
+  const cv::Mat margin = cv::getStructuringElement(
+      cv::MORPH_ELLIPSE, {2 * kPersonMarginPx + 1, 2 * kPersonMarginPx + 1});
   for (const auto& d : detections) {
     const cv::Rect box = cv::Rect(d.box) & cv::Rect(0, 0, size.width, size.height);
-    if (classes.isHighDynamic(d.class_id) && box.area() > 0) out(box).setTo(255);
+    if (!classes.isHighDynamic(d.class_id) || box.area() <= 0) continue;
+    double mode = 0.0;
+    const cv::Mat own = objectPixels(depth_m, box, band_m, &mode);
+    if (own.empty()) {  // no depth in the box: all of it
+      out(box).setTo(255);
+      continue;
+    }
+    cv::Mat grown;
+    cv::dilate(own(box), grown, margin);
+    out(box) |= grown;
   }
   return out;
 }
