@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/core/dynamic/class_table.hpp"
 #include "dynamap/core/dynamic/region_fusion.hpp"
 #include "mask_share.hpp"
 
@@ -297,6 +298,36 @@ TEST(FusionOverTime, OneObjectWithTwoLabelsTakesItsBetterScoredClass) {
   const Detection person{cv::Rect2f(195, 145, 175, 210), 0, 0.8f};
   RegionFusion other(c, classes);
   EXPECT_EQ(other.fuse(FusionMode::kBoth, depth, {}, {}, {chair, person}).objects.size(), 2u);
+}
+
+// A mover track (a seen-through region, masked while new) that grows over a surface holding
+// proven-static landmarks ends there, as a new one would not start: it is the static surface
+// the check saw through. Over a surface without them it goes on (masked, then carried).
+TEST(FusionOverTime, AMoverTrackEndsWhereItGrowsOverProvenStaticPoints) {
+  Scene s;
+  const cv::Rect first(200, 200, 160, 160), grown(200, 150, 200, 210);  // IoU .61
+  s.place(grown, 1.5f);
+  DynamicConfig c;
+  const auto mover = [](const cv::Rect& r) {
+    return Detection{cv::Rect2f(r), ClassTable::kMover, 1.f};
+  };
+  const auto run = [&](const std::vector<std::uint8_t>& proven_flags) {
+    RegionFusion fusion(c, ClassTable(c));
+    FusionResult r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.quiet, {mover(first)});
+    EXPECT_GT(maskedShare(r.mask, first), 0.9);  // new: masked
+    FusionEvidence ev;
+    ev.proven_static = proven_flags;
+    r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.quiet, {mover(grown)}, ev);
+    const double grown_share = maskedShare(r.mask, grown);
+    r = fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.quiet, {});  // not detected
+    return std::make_pair(grown_share, r.objects.size());
+  };
+  const auto [proven_share, proven_objects] = run(s.flagged(grown));
+  EXPECT_LT(proven_share, 0.01);
+  EXPECT_EQ(proven_objects, 0u);  // ended, not carried
+  const auto [unproven_share, unproven_objects] = run(s.quiet);
+  EXPECT_GT(unproven_share, 0.9);
+  EXPECT_EQ(unproven_objects, 1u);
 }
 
 }  // namespace
