@@ -114,8 +114,8 @@ struct TrackerConfig {
   int kf_reuse_orb_fast_threshold = 7;
   /// A keyframe made where the 8 nearest keyframes older than the bundle-adjustment window saw
   /// all but kf_reuse_max_uncovered_share of its static view, and their landmarks alone
-  /// (2 x min_inliers inliers) pose the frame within 1 cm / 0.5 deg of its own tracks, is culled
-  /// when it leaves the window: it leaves the keyframe list and a saved map, follows the nearest
+  /// (2 x min_inliers inliers) pose the frame within 5 cm / 3 deg of its own tracks (1 cm /
+  /// 0.5 deg with kf_cull_online), is culled when it leaves the window: it leaves the keyframe list and a saved map, follows the nearest
   /// of them rigidly (its frames keep their poses; its observations stay in bundle adjustment
   /// through that parent, its landmarks are searched as the parent's), and the dense map keeps
   /// what it held. Those still in the window at finish() are culled after the final bundle

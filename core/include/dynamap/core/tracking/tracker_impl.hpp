@@ -132,8 +132,8 @@ class Tracker::Impl {
                        const std::vector<std::uint64_t>& near) const;
   /// Whether a keyframe made now would be redundant (tracking.kf_cull_redundant): the nearest
   /// 8 keyframes older than the bundle-adjustment window cover its static view but
-  /// kf_reuse_max_uncovered_share, and their landmarks alone pose the frame within 1 cm / 0.5 deg
-  /// of T_W_C. `parent` = the nearest of them. Changes nothing.
+  /// kf_reuse_max_uncovered_share, and their landmarks alone pose the frame within 5 cm / 3 deg
+  /// of T_W_C (1 cm / 0.5 deg when culled online). `parent` = the nearest of them. Changes nothing.
   bool coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Mat& gray,
                                const cv::Mat& track_mask, const cv::Mat& movers,
                                const Eigen::Isometry3d& T_W_C, std::uint64_t& parent);
