@@ -17,6 +17,9 @@ constexpr std::size_t kReuseSourceKeyframes = 8;
 /// The most a revisit's old landmarks may move a frame's pose: farther, the matches are wrong.
 constexpr double kRevisitMaxStepM = 0.05;
 constexpr double kRevisitMaxStepDeg = 3.0;
+/// ... and the most they may lie from its own tracks for a keyframe culled during the run.
+constexpr double kOnlineCullMaxStepM = 0.01;
+constexpr double kOnlineCullMaxStepDeg = 0.5;
 
 /// Whether the pose with the old landmarks lies within max_m / max_deg of the pose of the
 /// frame's own tracks.
@@ -170,7 +173,7 @@ bool Tracker::Impl::coveredByOlderKeyframes(const RgbdFrame& frame, const cv::Ma
   // may (Bonn x10: 33 -> 27 keyframes, every pose the same; crowded frames' old landmarks pose
   // them 1-2 cm off their own tracks).
   const bool agree = config_.kf_cull_online
-                         ? smallStep(T_W_C, T, 0.01, 0.5)
+                         ? smallStep(T_W_C, T, kOnlineCullMaxStepM, kOnlineCullMaxStepDeg)
                          : smallStep(T_W_C, T, kRevisitMaxStepM, kRevisitMaxStepDeg);
   if (!posed || inliers < 2 * config_.min_inliers || !agree) return false;
   parent = sources.front();

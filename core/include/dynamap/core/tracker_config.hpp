@@ -115,10 +115,10 @@ struct TrackerConfig {
   /// A keyframe made where the 8 nearest keyframes older than the bundle-adjustment window saw
   /// all but kf_reuse_max_uncovered_share of its static view, and their landmarks alone
   /// (2 x min_inliers inliers) pose the frame within 5 cm / 3 deg of its own tracks (1 cm /
-  /// 0.5 deg with kf_cull_online), is culled when it leaves the window: it leaves the keyframe list and a saved map, follows the nearest
-  /// of them rigidly (its frames keep their poses; its observations stay in bundle adjustment
-  /// through that parent, its landmarks are searched as the parent's), and the dense map keeps
-  /// what it held. Those still in the window at finish() are culled after the final bundle
+  /// 0.5 deg with kf_cull_online), is culled when it leaves the window: it leaves the keyframe
+  /// list and a saved map, follows the nearest of them rigidly (its frames keep their poses; its
+  /// observations stay in bundle adjustment through that parent, its landmarks are searched as
+  /// the parent's), and the dense map keeps what it held. Those still in the window at finish() are culled after the final bundle
   /// adjustment (their poses as it left them).
   bool kf_cull_redundant = true;
   /// Cull them during the run, when they leave the window (teddy x10: 96 -> 80 keyframes, one
