@@ -304,8 +304,10 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
   people.insert(people.end(), prev_people_.begin(), prev_people_.end());
   const cv::Mat exclude = notMovers(depth_m, prev_kept_movers_, evidence.planes, people, classes_,
                                     config_.depth_band_m);
-  const std::vector<Detection> movers = moverDetections(depth_m, evidence.T_W_C, evidence.K, *view,
-                                                        exclude, seenThroughOptions(config_));
+  const cv::Mat walkers = peoplePixels(depth_m, prev_walkers_, classes_, config_.depth_band_m);
+  const std::vector<Detection> movers =
+      moverDetections(depth_m, evidence.T_W_C, evidence.K, *view, exclude,
+                      seenThroughOptions(config_), nullptr, walkers);
   dets.insert(dets.end(), movers.begin(), movers.end());
   record("movers", msSince(start));
 }
@@ -382,10 +384,13 @@ void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const FusionResult& f
   prev_mask_ = fused.mask;
   if (moverTracks()) prev_kept_movers_ = keptMovers(fused);
   prev_people_.clear();
+  prev_walkers_.clear();
   for (const auto& o : fused.objects) {
-    if (moverTracks() && classes_.isHighDynamic(o.detection.class_id) &&
-        o.detection.class_id != ClassTable::kMover)
-      prev_people_.push_back(o.detection);
+    if (!moverTracks() || !classes_.isHighDynamic(o.detection.class_id) ||
+        o.detection.class_id == ClassTable::kMover)
+      continue;
+    prev_people_.push_back(o.detection);
+    if (o.moving) prev_walkers_.push_back(o.detection);
   }
   pending_ = DepthView();
   if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);

@@ -130,7 +130,8 @@ class DynamicMotionFilter : public MotionFilter {
   RigidMotion motion_;        ///< last frame-to-frame camera motion (diagnostics)
   cv::Mat prev_mask_;         ///< last frame's mask: its matches do not vote for the camera motion
   cv::Mat prev_kept_movers_;  ///< last frame's movers decided static (none is found there)
-  std::vector<Detection> prev_people_;  ///< last frame's high-dynamic objects (no mover there)
+  std::vector<Detection> prev_people_;   ///< last frame's high-dynamic objects (no mover there)
+  std::vector<Detection> prev_walkers_;  ///< ... those of them that were moving
   /// Recent frames with their final poses (DynamicConfig::dense_check_frames). The last frame
   /// waits in pending_ until the next filter() call brings its final pose.
   DepthHistory depth_history_;
