@@ -40,28 +40,30 @@ std::uint64_t voxelKey(const Eigen::Vector3f& p, double inv, Eigen::Vector3i* ce
   return packCell(c);
 }
 
+// How many of `points` have a point of `index` within `radius` (of a k-d tree, in parallel).
+std::size_t countWithin(const PointIndex& index, const std::vector<Eigen::Vector3f>& points,
+                        float radius) {
+  std::vector<char> within(points.size(), 0);
+  parallelFor(points.size(), [&](std::size_t i) {
+    within[i] = index.nearestDistance(points[i], radius) <= radius ? 1 : 0;
+  });
+  std::size_t n = 0;
+  for (const char c : within) n += c;
+  return n;
+}
+
 // The ghosts off the settled reference, and its points the map covers (MapMetrics).
-void addSettledMetrics(const std::vector<Eigen::Vector3f>& map,
+void addSettledMetrics(const PointIndex& map_index,
                        const std::vector<Eigen::Vector3f>& ghost_points,
                        const ReferenceClouds& refs, const MapMetricsOptions& options,
                        MapMetrics* m) {
-  if (!refs.settled_ref || refs.settled_points.empty() || map.empty()) return;
   const auto ghost_thr = static_cast<float>(options.ghost_dynamic_m);
-  std::vector<char> on_path(ghost_points.size(), 0);
-  parallelFor(ghost_points.size(), [&](std::size_t i) {
-    on_path[i] = refs.settled_ref->nearestDistance(ghost_points[i], ghost_thr) > ghost_thr ? 1 : 0;
-  });
-  const PointIndex map_index(map);
-  const auto thr = static_cast<float>(options.threshold_m);
-  std::vector<char> covered(refs.settled_points.size(), 0);
-  parallelFor(refs.settled_points.size(), [&](std::size_t i) {
-    covered[i] = map_index.nearestDistance(refs.settled_points[i], thr) <= thr ? 1 : 0;
-  });
-  std::size_t path = 0, n_covered = 0;
-  for (const char c : on_path) path += c;
-  for (const char c : covered) n_covered += c;
-  m->path_ghost_ratio = static_cast<double>(path) / map.size();
-  m->settled_completeness = static_cast<double>(n_covered) / refs.settled_points.size();
+  const std::size_t at_place = countWithin(*refs.settled_ref, ghost_points, ghost_thr);
+  m->path_ghost_ratio = static_cast<double>(ghost_points.size() - at_place) / map_index.size();
+  m->settled_completeness =
+      static_cast<double>(
+          countWithin(map_index, refs.settled_points, static_cast<float>(options.threshold_m))) /
+      refs.settled_points.size();
 }
 
 }  // namespace
@@ -260,17 +262,15 @@ MapMetrics computeMapMetrics(const std::vector<Eigen::Vector3f>& map_points_W,
     ++m.ghost_fragments;
     m.ghost_fragment_points += n;
   }
-  addSettledMetrics(map, ghost_points, refs, options, &m);
-  if (!options.completeness) return m;
+  const bool settled = refs.settled_ref && !refs.settled_points.empty();
+  if (!options.completeness && !settled) return m;
   const PointIndex map_index(map);
-  std::vector<char> covered(refs.static_points.size(), 0);
-  parallelFor(refs.static_points.size(), [&](std::size_t i) {
-    covered[i] = map_index.nearestDistance(refs.static_points[i], thr) <= thr ? 1 : 0;
-  });
-  std::size_t n_covered = 0;
-  for (const char c : covered) n_covered += c;
-  m.completeness =
-      refs.static_points.empty() ? 0.0 : static_cast<double>(n_covered) / refs.static_points.size();
+  if (settled) addSettledMetrics(map_index, ghost_points, refs, options, &m);
+  if (!options.completeness) return m;
+  m.completeness = refs.static_points.empty()
+                       ? 0.0
+                       : static_cast<double>(countWithin(map_index, refs.static_points, thr)) /
+                             refs.static_points.size();
   const double ps = m.precision + m.completeness;
   m.fscore = ps > 0 ? 2.0 * m.precision * m.completeness / ps : 0.0;
   return m;
