@@ -30,6 +30,7 @@ class PluginBackend final : public MapBackend {
   bool needsPoints() const override { return inner_->needsPoints(); }
   bool importMap(const std::string& dir) override { return inner_->importMap(dir); }
   bool canDeintegrate() const override { return inner_->canDeintegrate(); }
+  double cellSizeM() const override { return inner_->cellSizeM(); }
   void deintegrate(const KeyframeView& view) override { inner_->deintegrate(view); }
   void moveKeyframe(const KeyframeView& from, const KeyframeView& to) override {
     inner_->moveKeyframe(from, to);

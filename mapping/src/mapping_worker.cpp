@@ -301,11 +301,14 @@ void MappingWorker::recordPointsLocked(std::uint64_t id, StaticPoints& sp) const
 
 void MappingWorker::rebuildIfNeeded(bool force) {
   if (!force && backend_->poseUpdateMode() != PoseUpdateMode::kReintegrate) return;
+  // Half a cell of the backend's map, at least kReintegrateTranslationM (and the rotation in
+  // proportion): a smaller move changes little that the cells can hold.
+  const double scale = std::max(1.0, 0.5 * backend_->cellSizeM() / kReintegrateTranslationM);
   std::vector<std::uint64_t> moved;
   for (const std::uint64_t id : order_) {
     const KeyframeRecord& rec = records_.at(id);
-    if (movedBeyond(rec.T_integrated, rec.T_current, kReintegrateTranslationM,
-                    kReintegrateRotationRad)) {
+    if (movedBeyond(rec.T_integrated, rec.T_current, scale * kReintegrateTranslationM,
+                    scale * kReintegrateRotationRad)) {
       moved.push_back(id);
     }
   }

@@ -51,6 +51,7 @@ class OctomapBackend final : public MapBackend {
     ++keyframes_;
   }
   bool canDeintegrate() const override { return true; }
+  double cellSizeM() const override { return resolution_m_; }
   // The same rays again, their log-odds subtracted: exact but where a cell's clamping cut an
   // update off (a cell at the clamp takes back more than the keyframe had added).
   void deintegrate(const KeyframeView& view) override {

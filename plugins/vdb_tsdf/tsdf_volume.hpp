@@ -47,6 +47,7 @@ inline constexpr const char* kDigestSuffix = ".crc32";
 class TsdfVolume {
  public:
   explicit TsdfVolume(const TsdfOptions& options);
+  const TsdfOptions& options() const { return options_; }
   void integrate(const PinholeCamera& camera, const cv::Mat& depth_m, const cv::Mat& bgr,
                  const Eigen::Isometry3d& T_W_C);
   /// Back to the imported grids (importVdb()), or empty.

@@ -54,6 +54,7 @@ class VdbTsdfBackend final : public MapBackend {
   PoseUpdateMode poseUpdateMode() const override { return PoseUpdateMode::kReintegrate; }
   bool fusesViews() const override { return true; }
   bool needsPoints() const override { return false; }
+  double cellSizeM() const override { return volume_.options().voxel_size_m; }
   void reset() override {
     volume_.reset();
     keyframes_ = 0;

@@ -115,9 +115,12 @@ TEST_P(BackendReload, NewKeyframesExtendTheImportedMapAlsoWhenTheirPosesMove) {
   const Outcome run1 = mapSteps(create(), kRun1, {}, saved);
   const Outcome only2 = mapSteps(create(), kRun2, {}, freshTempDir("reload_only_" + GetParam()));
   const Outcome both = mapSteps(create(), kRun2, saved, freshTempDir("reload_both_" + GetParam()));
-  // Poses moved by 2 cm: a volumetric backend rebuilds from its imported map.
+  // Poses moved by 2 cm, and more than half a cell of the backend's map (MapBackend::cellSizeM():
+  // a smaller move leaves a keyframe where it went in): a volumetric backend rebuilds from its
+  // imported map.
+  const double shift_m = std::max(0.02, 0.6 * backendCase(GetParam()).voxel_m);
   const Outcome moved = mapSteps(create(), kRun2, saved, freshTempDir("reload_move_" + GetParam()),
-                                 Eigen::Vector3d(0.02, 0.0, 0.0));
+                                 Eigen::Vector3d(shift_m, 0.0, 0.0));
   std::printf(
       "%s elements (exported): run 1 %zu (%zu), run 2 alone %zu (%zu), run 2 on run 1 %zu (%zu), "
       "moved %zu (%zu, %zu re-integrated)\n",

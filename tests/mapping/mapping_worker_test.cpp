@@ -35,8 +35,9 @@ struct FakeLog {
 
 class FakeBackend final : public MapBackend {
  public:
-  FakeBackend(FakeLog* log, PoseUpdateMode mode, bool fuses = false, bool deintegrates = false)
-      : log_(log), mode_(mode), fuses_(fuses), deintegrates_(deintegrates) {}
+  FakeBackend(FakeLog* log, PoseUpdateMode mode, bool fuses = false, bool deintegrates = false,
+              double cell_m = 0.0)
+      : log_(log), mode_(mode), fuses_(fuses), deintegrates_(deintegrates), cell_m_(cell_m) {}
   void integrate(const KeyframeView& view) override {
     std::unique_lock<std::mutex> lock(log_->mutex);
     log_->cv.wait(lock, [&] { return log_->released; });
@@ -54,6 +55,7 @@ class FakeBackend final : public MapBackend {
   MapStats stats() const override { return {}; }
   bool fusesViews() const override { return fuses_; }
   bool canDeintegrate() const override { return deintegrates_; }
+  double cellSizeM() const override { return cell_m_; }
   void deintegrate(const KeyframeView& view) override {
     std::lock_guard<std::mutex> lock(log_->mutex);
     log_->taken_out.emplace_back(view.id, view.T_W_C);
@@ -64,6 +66,7 @@ class FakeBackend final : public MapBackend {
   PoseUpdateMode mode_;
   bool fuses_;
   bool deintegrates_;
+  double cell_m_;
 };
 
 KeyframePacketPtr packet(std::uint64_t id) {
@@ -311,6 +314,33 @@ TEST(MappingWorker, MovesOnlyTheMovedKeyframesOfABackendThatCanTakeThemOut) {
       EXPECT_EQ(worker.reintegratedKeyframes(), 4u);
     }
     EXPECT_TRUE(log.poses.at(0).isApprox(updates[0].T_W_C));
+  }
+}
+
+// A keyframe moved by less than half a cell of the backend's map (5 cm cells: 2 cm) stays where
+// it went in; beyond (3 cm), it is taken out and put in again. Cells of 2 cm or none: 1 cm.
+TEST(MappingWorker, AKeyframeMovedByLessThanHalfACellStays) {
+  for (const double cell : {0.0, 0.02, 0.05}) {
+    for (const double dx : {0.015, 0.02, 0.03}) {
+      FakeLog log;
+      log.released = true;
+      MappingWorker worker(
+          std::make_unique<FakeBackend>(&log, PoseUpdateMode::kReintegrate, false, true, cell),
+          SyntheticScene::camera(), countingOptions(), 4, nullptr);
+      std::vector<PoseUpdate> updates;
+      for (std::uint64_t id = 0; id < 3; ++id) {
+        const auto kf = packet(id);
+        worker.push(kf);
+        const double shift = id == 0 ? dx : 0.0;
+        updates.push_back({id, Eigen::Translation3d(shift, 0, 0) * kf->T_W_C});
+      }
+      worker.drain();
+      worker.applyPoseUpdates(updates);
+      worker.finish();
+      const bool moves = dx > std::max(MappingWorker::kReintegrateTranslationM, cell / 2);
+      EXPECT_EQ(log.taken_out.size(), moves ? 1u : 0u) << cell << " " << dx;
+      EXPECT_EQ(log.resets, 0);
+    }
   }
 }
 

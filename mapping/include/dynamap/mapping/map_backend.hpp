@@ -102,6 +102,9 @@ class MapBackend {
     deintegrate(from);
     integrate(to);
   }
+  /// The edge of the map's cells (m; 0 = no cells, e.g. points). A kReintegrate keyframe whose
+  /// pose moved by less than half a cell stays where it went in (MappingWorker).
+  virtual double cellSizeM() const { return 0.0; }
 };
 
 /// Backend parameters as given in the configuration (keys without the "<backend>." prefix).
@@ -111,8 +114,8 @@ using BackendParams = std::map<std::string, std::string>;
 /// caller; throws MappingError for a bad parameter.
 using BackendFactoryFn = MapBackend* (*)(const BackendParams& params);
 /// v2: MapBackend::needsPoints(); v3: MapBackend::importMap(); v4: canDeintegrate() and
-/// deintegrate(); v5: moveKeyframe() (a plugin built for an older version has a shorter vtable:
-/// refused by name).
-inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v5";
+/// deintegrate(); v5: moveKeyframe(); v6: cellSizeM() (a plugin built for an older version has a
+/// shorter vtable: refused by name).
+inline constexpr const char* kBackendFactorySymbol = "dynamap_create_backend_v6";
 
 }  // namespace dynamap

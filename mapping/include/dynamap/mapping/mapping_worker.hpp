@@ -30,8 +30,10 @@ namespace dynamap {
 /// before and window_after_s after it saw through or voted out is removed (removeSeenThrough()),
 /// all with the current poses, and it goes to the backend. Pose updates go to the backend as they
 /// come (kInPlace); volumetric backends (kReintegrate) follow them in finish() where a keyframe
-/// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad`: a backend that can
-/// take keyframes out has those moved out and in again, else the map is rebuilt (for that the
+/// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad` (or, if larger,
+/// half a cell of the backend's map, MapBackend::cellSizeM(), the rotation in proportion): a
+/// backend that can take keyframes out has those moved out and in again, else the map is
+/// rebuilt (for that the
 /// worker keeps their keyframes' static depth, 16-bit, and colour; a kInPlace backend's are
 /// released once integrated, the views once out of the window). With options.visibility_final_pass
 /// (the offline extra) the keyframes go to the backend only in finish(), after the held revision

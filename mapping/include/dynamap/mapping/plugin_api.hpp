@@ -7,6 +7,6 @@
 
 #define DYNAMAP_DEFINE_BACKEND(BackendClass)                               \
   extern "C" __attribute__((visibility("default"))) ::dynamap::MapBackend* \
-  dynamap_create_backend_v5(const ::dynamap::BackendParams& params) {      \
+  dynamap_create_backend_v6(const ::dynamap::BackendParams& params) {      \
     return new BackendClass(params);                                       \
   }
