@@ -67,7 +67,10 @@ TEST(DynamicConfigBinding, MoversConfigTurnsOnTheMoverKeys) {
   EXPECT_TRUE(c.dynamic.hold_moved_objects);
   EXPECT_DOUBLE_EQ(c.dynamic.dense_barrier_step_m, 0.03);
   const AppConfig d = loadAppConfig((test::sourceDir() / "config/default.yaml").string(), {});
-  EXPECT_FALSE(d.dynamic.mover_tracks || d.dynamic.mover_follow_anchors);
+  EXPECT_TRUE(d.dynamic.mover_tracks);
+  EXPECT_EQ(d.dynamic.mover_view_frames, 12);
+  EXPECT_FALSE(d.dynamic.mover_follow_anchors);
+  EXPECT_DOUBLE_EQ(d.dynamic.dense_barrier_step_m, 0.0);
   EXPECT_TRUE(d.dynamic.hold_moved_objects);
 }
 
