@@ -118,8 +118,8 @@ struct TrackerConfig {
   /// 0.5 deg with kf_cull_online), is culled when it leaves the window: it leaves the keyframe
   /// list and a saved map, follows the nearest of them rigidly (its frames keep their poses; its
   /// observations stay in bundle adjustment through that parent, its landmarks are searched as
-  /// the parent's), and the dense map keeps what it held. Those still in the window at finish() are culled after the final bundle
-  /// adjustment (their poses as it left them).
+  /// the parent's), and the dense map keeps what it held. Those still in the window at finish()
+  /// are culled after the final bundle adjustment (their poses as it left them).
   bool kf_cull_redundant = true;
   /// Cull them during the run, when they leave the window (teddy x10: 96 -> 80 keyframes, one
   /// pass 64), instead of all at finish() after the final bundle adjustment (the same keyframes

@@ -33,12 +33,12 @@ namespace dynamap {
 /// moved by more than `kReintegrateTranslationM` / `kReintegrateRotationRad` (or, if larger,
 /// half a cell of the backend's map, MapBackend::cellSizeM(), the rotation in proportion): a
 /// backend that can take keyframes out has those moved out and in again, else the map is
-/// rebuilt (for that the
-/// worker keeps their keyframes' static depth, 16-bit, and colour; a kInPlace backend's are
-/// released once integrated, the views once out of the window). With options.visibility_final_pass
-/// (the offline extra) the keyframes go to the backend only in finish(), after the held revision
-/// and the visibility pass over all of them with the final poses. All public methods are
-/// thread-safe; exportMap() and stats() see the map as it is (final after finish()).
+/// rebuilt (for that the worker keeps their keyframes' static depth, 16-bit, and colour; a
+/// kInPlace backend's are released once integrated, the views once out of the window). With
+/// options.visibility_final_pass (the offline extra) the keyframes go to the backend only in
+/// finish(), after the held revision and the visibility pass over all of them with the final
+/// poses. All public methods are thread-safe; exportMap() and stats() see the map as it is
+/// (final after finish()).
 class MappingWorker {
  public:
   static constexpr double kReintegrateTranslationM = 0.01;
