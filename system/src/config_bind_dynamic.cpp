@@ -64,6 +64,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addBool("dynamic.hold_moved_objects", &c.hold_moved_objects);
   schema.addBool("dynamic.mover_follow_anchors", &c.mover_follow_anchors);
   schema.addInt("dynamic.mover_view_frames", &c.mover_view_frames, 0, 120);
+  schema.addDouble("dynamic.mover_max_depth_m", &c.mover_max_depth_m, 0.0, 100.0);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
   schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);

@@ -123,6 +123,30 @@ TEST(DepthCheck, APushedBoxIsSeenThroughAndMaskedWholeWithoutTheFloor) {
   EXPECT_LT(outside, 0.25 * box_px);
 }
 
+TEST(DepthCheck, PixelsBeyondTheMaximumDepthAreNotSampled) {
+  const PushedBox world;  // the box's front face is 2.7 m away
+  const auto now = world.at(6);
+  const DepthView view = viewOf(world.at(0), cameraAt(0), 0);
+  const cv::Vec4d K = intrinsics(world.camera);
+  const cv::Rect all(0, 0, world.camera.width, world.camera.height);
+  DepthCheckOptions near_only;
+  near_only.max_depth_m = 2.5;
+  const DepthAgreement box =
+      compareWithView(now.depth_m, now.mask, all, toMatx(cameraAt(6)), K, view, near_only);
+  EXPECT_EQ(box.samples, 0);
+  SeenThroughOptions o;
+  o.check.max_depth_m = 2.5;
+  EXPECT_EQ(cv::countNonZero(
+                seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o)),
+            0);
+  // Within the range the box is found as before.
+  o.check.max_depth_m = 4.0;
+  EXPECT_GT(cv::countNonZero(
+                seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o) &
+                now.mask),
+            0.9 * cv::countNonZero(now.mask));
+}
+
 TEST(DepthCheck, DecidedObjectsAreLeftAlone) {
   const PushedBox world;
   const auto now = world.at(6);

@@ -96,7 +96,7 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
     for (int x = r.x + step / 2; x < r.x + r.width; x += step) {
       if (!region.empty() && region.at<uchar>(y, x) == 0) continue;
       const float z = interiorDepth(depth_m, x, y);
-      if (z <= 0.f) continue;
+      if (z <= 0.f || (o.max_depth_m > 0.0 && z > o.max_depth_m)) continue;
       const cv::Vec4d p_C((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z, 1.0);
       const cv::Vec4d p_V = T_V_C * p_C;
       if (p_V[2] <= 0.1) continue;

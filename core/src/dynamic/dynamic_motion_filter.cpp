@@ -305,9 +305,10 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
   const cv::Mat exclude = notMovers(depth_m, prev_kept_movers_, evidence.planes, people, classes_,
                                     config_.depth_band_m);
   const cv::Mat walkers = peoplePixels(depth_m, prev_walkers_, classes_, config_.depth_band_m);
-  const std::vector<Detection> movers =
-      moverDetections(depth_m, evidence.T_W_C, evidence.K, *view, exclude,
-                      seenThroughOptions(config_), nullptr, walkers);
+  SeenThroughOptions options = seenThroughOptions(config_);
+  options.check.max_depth_m = config_.mover_max_depth_m;
+  const std::vector<Detection> movers = moverDetections(depth_m, evidence.T_W_C, evidence.K, *view,
+                                                        exclude, options, nullptr, walkers);
   dets.insert(dets.end(), movers.begin(), movers.end());
   record("movers", msSince(start));
 }

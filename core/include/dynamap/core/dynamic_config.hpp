@@ -136,6 +136,11 @@ struct DynamicConfig {
   /// Movers are found against the depth this many frames back (0 = dense_check_frames). 12
   /// finds far more of a pushed chair or box (BENCHMARKS.md).
   int mover_view_frames = 12;
+  /// Movers are sought only in current depth up to this range (m; 0 = any): beyond the range
+  /// the map takes (mapping.depth_max_m, 4 m) a structured-light sensor's depth
+  /// bends by tens of centimetres towards the image corners, and a far wall seen again from
+  /// another place looked "seen through" (crowd x10: every backward pass, at 4-5.2 m).
+  double mover_max_depth_m = 4.0;
   /// An object of another class (a chair) that was seen to move (its flags, or its anchors off
   /// by twice the still limit) is masked until it has stood still for static_confirm_frames, as
   /// a person is (false: only while its smoothed flags say it moves). A chair pushed away from

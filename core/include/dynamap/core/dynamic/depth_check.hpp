@@ -38,6 +38,7 @@ struct DepthCheckOptions {
   /// centimetres at 3 m towards the image borders on a Kinect).
   double relative_margin = 0.02;
   int border_px = 16;  ///< pixels this close to the image border are not sampled
+  double max_depth_m = 0.0;  ///< pixels with a deeper current depth are not sampled (0 = any)
 };
 
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
