@@ -66,6 +66,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addInt("dynamic.mover_view_frames", &c.mover_view_frames, 0, 120);
   schema.addDouble("dynamic.mover_max_depth_m", &c.mover_max_depth_m, 0.0, 100.0);
   schema.addInt("dynamic.track_max_missed_frames", &c.track_max_missed_frames, 0, 100000);
+  schema.addInt("dynamic.remember_still_frames", &c.remember_still_frames, 0, 1000000);
   schema.addBool("dynamic.carried_border_exit", &c.carried_border_exit);
   schema.addDouble("dynamic.depth_band_m", &c.depth_band_m, 0.01, 10.0);
   schema.addDouble("dynamic.person_max_height_m", &c.person_max_height_m, 0.0, 10.0);

@@ -4,6 +4,7 @@
 #include "fusion_clusters.hpp"
 #include "object_state.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 #include <opencv2/imgproc.hpp>
@@ -21,6 +22,10 @@ constexpr float kUnderPersonShare = 0.3f;     ///< underPerson(): share of its b
 constexpr int kMoverMinProven = 8;            ///< provenStaticMover(): proven-static points,
 constexpr int kMoverProvenShareInverse = 10;  ///< ... and at least 1/10 of its points
 constexpr float kSameObjectIou = 0.6f;        ///< two labels of one object (oneLabelPerObject)
+/// rememberEndedStill(): still this many times static_confirm_frames, without slow moves (a
+/// swayer at the end of a sway is still for a moment) ...
+constexpr int kRememberQuietFactor = 4;
+constexpr int kRememberSharedInverse = 4;  ///< ... and found again with a quarter of its points
 
 /// The world position (evidence.T_W_C) of the centroid of `region`'s pixels in `box` at depth
 /// `depth_m`; false (and *p_W untouched) if the box holds none of them.
@@ -166,16 +171,51 @@ cv::Mat RegionFusion::objectRegion(const Frame& f, const cv::Rect& box, ObjectDe
 }
 
 cv::Mat RegionFusion::detectedRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d,
-                                     int& track) const {
+                                     int& track, const ObjectTrack** remembered) const {
+  *remembered = nullptr;
   const ObjectTrack* prev = track >= 0 ? &tracks_[track] : nullptr;
   cv::Mat region = objectRegion(f, box, d, prev);
   if (prev != nullptr || f.mode != FusionMode::kBoth) return region;
-  // No box overlaps it enough; the points on it may still be an earlier track's.
-  track = trackSharingPoints(idsIn(region, f.points, f.evidence), tracks_, d.detection.class_id,
-                             kAnchorMinPoints);
-  if (track < 0) return region;
+  // No box overlaps it enough; the points on it may still be an earlier track's ...
+  const std::vector<std::uint64_t> ids = idsIn(region, f.points, f.evidence);
+  track = trackSharingPoints(ids, tracks_, d.detection.class_id, kAnchorMinPoints);
+  if (track >= 0) {
+    d = newDecision(d.detection);
+    return objectRegion(f, box, d, &tracks_[track]);
+  }
+  // ... or a still object's that was hidden for a while (its anchors judge it as before).
+  const int shared = std::max(kAnchorMinPoints, static_cast<int>(ids.size()) / kRememberSharedInverse);
+  const int r = trackSharingPoints(ids, remembered_, d.detection.class_id, shared);
+  if (r < 0) return region;
+  *remembered = &remembered_[static_cast<std::size_t>(r)];
   d = newDecision(d.detection);
-  return objectRegion(f, box, d, &tracks_[track]);
+  return objectRegion(f, box, d, *remembered);
+}
+
+bool RegionFusion::carried(std::size_t t, const cv::Size& image) const {
+  const ObjectTrack& track = tracks_[t];
+  return track.missed < config_.track_max_missed_frames &&
+         clampRect(track.box, image).area() * 4 >= track.box.area();
+}
+
+void RegionFusion::rememberEndedStill(const std::vector<bool>& matched, const cv::Size& image) {
+  for (std::size_t k = remembered_.size(); k-- > 0;) {
+    if (remembered_until_[k] > frame_) continue;
+    remembered_.erase(remembered_.begin() + static_cast<std::ptrdiff_t>(k));
+    remembered_until_.erase(remembered_until_.begin() + static_cast<std::ptrdiff_t>(k));
+  }
+  if (config_.remember_still_frames <= 0) return;
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    const ObjectTrack& track = tracks_[t];
+    const bool ended = !(t < matched.size() && matched[t]) && !carried(t, image);
+    if (ended && !track.moving && track.slow_moves == 0 &&
+        track.quiet_frames >= kRememberQuietFactor * config_.static_confirm_frames &&
+        classes_.isHighDynamic(track.class_id) && track.class_id != ClassTable::kMover &&
+        static_cast<int>(track.anchors.size()) >= kAnchorMinPoints) {
+      remembered_.push_back(track);
+      remembered_until_.push_back(frame_ + config_.remember_still_frames);
+    }
+  }
 }
 
 void RegionFusion::applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
@@ -263,7 +303,8 @@ std::vector<bool> RegionFusion::fuseDetections(Frame& f, const std::vector<Detec
     if (box.area() <= 0) continue;
     int track = track_of[k];
     d.under_person = underPerson(d.detection, detections);
-    cv::Mat region = detectedRegion(f, box, d, track);
+    const ObjectTrack* remembered = nullptr;
+    cv::Mat region = detectedRegion(f, box, d, track, &remembered);
     if (provenStaticMover(d)) {
       if (track >= 0) matched[track] = true;  // its track ends: not carried either
       continue;
@@ -271,8 +312,8 @@ std::vector<bool> RegionFusion::fuseDetections(Frame& f, const std::vector<Detec
     if (f.mode == FusionMode::kDetector) {
       d.moving_now = d.moving = true;
     } else {
-      const ObjectTrack* prev = track >= 0 ? &tracks_[track] : nullptr;
-      if (prev != nullptr) matched[track] = true;
+      const ObjectTrack* prev = track >= 0 ? &tracks_[track] : remembered;
+      if (track >= 0) matched[track] = true;
       next.push_back(nextObjectState(d, prev, f.evidence, config_,
                                      classes_.isHighDynamic(d.detection.class_id)));
     }
@@ -287,10 +328,7 @@ void RegionFusion::carryUndetected(Frame& f, const std::vector<bool>& matched,
   for (std::size_t t = 0; t < tracks_.size(); ++t) {
     const ObjectTrack& track = tracks_[t];
     const cv::Rect box = clampRect(track.box, f.depth_m.size());
-    if (matched[t] || track.missed >= config_.track_max_missed_frames ||
-        box.area() * 4 < track.box.area()) {
-      continue;
-    }
+    if (matched[t] || !carried(t, f.depth_m.size())) continue;
     ObjectDecision d = newDecision(Detection{track.box, track.class_id, 0.f});
     d.carried = true;
     d.under_person = underPerson(d.detection, detections);
@@ -355,8 +393,10 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
     // Objects the detector did not report in this frame: a person seen a moment ago keeps its
     // mask (and its evidence) for a few frames, its box moved with the flow.
     if (mode == FusionMode::kBoth) carryUndetected(f, matched, all_detections, next, result);
+    if (mode == FusionMode::kBoth) rememberEndedStill(matched, depth_m.size());
   }
   tracks_ = std::move(next);
+  ++frame_;
   finishMasks(f, result);
   return result;
 }

@@ -153,6 +153,11 @@ struct DynamicConfig {
   bool mover_follow_anchors = false;
   /// An object the detector misses keeps its track (and, if moving, its mask) this many frames.
   int track_max_missed_frames = 8;
+  /// A person (or a teddy taken for one) confirmed still whose track ends (hidden behind walkers
+  /// longer than track_max_missed_frames) is remembered this many frames: detected again with
+  /// its own anchored points, still where they were, it is kept at once instead of being held
+  /// until it proves still again (crowd x10: the teddy masked in four keyframes). 0 = off.
+  int remember_still_frames = 300;
   /// Such a carried box at the image border whose centre shows depth, but none within 0.5 m of
   /// its object's last depth, has lost the object through the border: it masks nothing (false:
   /// it takes the centre's dominant depth, e.g. the wall behind a person who walked out).

@@ -143,8 +143,14 @@ class RegionFusion {
   cv::Mat objectRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d,
                        const ObjectTrack* prev) const;
   /// objectRegion() of a detection whose track is tracks_[track] (-1: none); without one, in
-  /// kBoth, the track whose anchors hold its points (then `track` and d are set anew).
-  cv::Mat detectedRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d, int& track) const;
+  /// kBoth, the track whose anchors hold its points (then `track` and d are set anew), else the
+  /// remembered still object's (*remembered set; `track` stays -1).
+  cv::Mat detectedRegion(const Frame& f, const cv::Rect& box, ObjectDecision& d, int& track,
+                         const ObjectTrack** remembered) const;
+  /// True if tracks_[t], not continued by a detection, is carried by the flow this frame.
+  bool carried(std::size_t t, const cv::Size& image) const;
+  /// Remembers the tracks that end this frame and were confirmed still; forgets old ones.
+  void rememberEndedStill(const std::vector<bool>& matched, const cv::Size& image);
   /// Marks the object's pixels claimed and masks (moving, static points carved out) or keeps it.
   void applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, const cv::Rect& box,
                    FusionResult& result) const;
@@ -152,6 +158,10 @@ class RegionFusion {
   DynamicConfig config_;
   ClassTable classes_;
   std::vector<ObjectTrack> tracks_;
+  long frame_ = 0;  ///< fuse() calls so far
+  /// Still objects whose tracks ended (remember_still_frames), and the frame each is forgotten.
+  std::vector<ObjectTrack> remembered_;
+  std::vector<long> remembered_until_;
 };
 
 }  // namespace dynamap
