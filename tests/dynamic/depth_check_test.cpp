@@ -136,15 +136,15 @@ TEST(DepthCheck, PixelsBeyondTheMaximumDepthAreNotSampled) {
   EXPECT_EQ(box.samples, 0);
   SeenThroughOptions o;
   o.check.max_depth_m = 2.5;
-  EXPECT_EQ(cv::countNonZero(
-                seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o)),
-            0);
+  EXPECT_EQ(
+      cv::countNonZero(seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o)),
+      0);
   // Within the range the box is found as before.
   o.check.max_depth_m = 4.0;
-  EXPECT_GT(cv::countNonZero(
-                seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o) &
-                now.mask),
-            0.9 * cv::countNonZero(now.mask));
+  EXPECT_GT(
+      cv::countNonZero(seenThroughRegions(now.depth_m, toMatx(cameraAt(6)), K, view, cv::Mat(), o) &
+                       now.mask),
+      0.9 * cv::countNonZero(now.mask));
 }
 
 TEST(DepthCheck, DecidedObjectsAreLeftAlone) {

@@ -44,8 +44,8 @@ bool maskedWhenSeenAgain(const DynamicConfig& c, int hidden, float shift) {
   RegionFusion fusion(c, ClassTable(c));
   for (int i = 0; i < 20; ++i) {
     const Frame f = frameWithPerson(0.f, ev);
-    const FusionResult r = fusion.fuse(FusionMode::kBoth, f.depth, f.points, f.flags,
-                                       {kPersonBox}, ev);
+    const FusionResult r =
+        fusion.fuse(FusionMode::kBoth, f.depth, f.points, f.flags, {kPersonBox}, ev);
     if (i == 19) {
       EXPECT_FALSE(r.objects.at(0).moving) << "kept before he is hidden";
     }

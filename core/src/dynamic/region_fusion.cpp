@@ -184,7 +184,8 @@ cv::Mat RegionFusion::detectedRegion(const Frame& f, const cv::Rect& box, Object
     return objectRegion(f, box, d, &tracks_[track]);
   }
   // ... or a still object's that was hidden for a while (its anchors judge it as before).
-  const int shared = std::max(kAnchorMinPoints, static_cast<int>(ids.size()) / kRememberSharedInverse);
+  const int shared =
+      std::max(kAnchorMinPoints, static_cast<int>(ids.size()) / kRememberSharedInverse);
   const int r = trackSharingPoints(ids, remembered_, d.detection.class_id, shared);
   if (r < 0) return region;
   *remembered = &remembered_[static_cast<std::size_t>(r)];
