@@ -8,7 +8,7 @@
 namespace dynamap {
 namespace {
 
-constexpr double kRevisitReachM = 0.5;      // a kept view judges keyframes this near...
+constexpr double kRevisitReachM = 0.5;  // a kept view judges keyframes this near...
 constexpr double kRevisitReachRad = 30.0 * 3.14159265358979 / 180.0;  // ... and turned
 constexpr double kRevisitSpacingM = 0.1;  // a view is kept where no kept one is this near...
 constexpr double kRevisitSpacingRad = 10.0 * 3.14159265358979 / 180.0;  // ... and turned
@@ -37,8 +37,20 @@ void MappingWorker::judgeReadyLocked(bool flush) {
     reviseHeldWindowLocked(judged_, end, flush);
     if (end > judged_) removeSeenThroughWindowLocked(judged_, end);
   }
-  for (std::size_t i = judged_; i < end; ++i) integrateRecordLocked(judge_[i]);
+  for (std::size_t i = judged_; i < end; ++i) {
+    KeyframeRecord& rec = records_.at(judge_[i]);
+    const bool startup = options_.visibility.enabled && options_.startup_s > 0.0 &&
+                         options_.startup_window_after_s > options_.window_after_s &&
+                         rec.timestamp_s < first_keyframe_s_ + options_.startup_s;
+    if (startup) {
+      rec.startup_wait = true;
+      startup_waiting_.push_back(judge_[i]);
+    } else {
+      integrateRecordLocked(judge_[i]);
+    }
+  }
   judged_ = end;
+  judgeStartupLocked(flush);
   // Context older than window_before_s before the next keyframe to judge (or the last judged)
   // leaves the window: its view and confirmed points are released.
   const std::size_t next = std::min(judged_, judge_.size() - 1);
@@ -48,14 +60,14 @@ void MappingWorker::judgeReadyLocked(bool flush) {
     if (rec.rejudge_held) {  // held_window_after_s beyond the window: no second look
       reviseOneLocked(judge_.front(), cv::Mat(), cv::Mat(), false);
       rec.rejudge_held = false;
-      if (!keepsDepth()) {
+      if (!keepsDepth() && !rec.startup_wait) {  // a startup keyframe is not mapped yet
         rec.depth_u16.release();
         rec.bgr.release();
       }
     }
     if (keepForRevisitsLocked(rec)) {
       revisit_.push_back(judge_.front());
-    } else {
+    } else if (!rec.startup_wait) {  // a startup keyframe's view goes with its second look
       rec.view = VisibilityView();
     }
     rec.held = HeldKeyframe();
@@ -134,7 +146,11 @@ void MappingWorker::secondLookLocked(std::uint64_t id, const cv::Mat& hit, const
     StaticPoints sp;  // only the pixels this look unmasked
     sp.static_depth_m = staticDepth(depth_m, map_mask, options_);
     sp.static_depth_m.setTo(0.0f, ~fresh);
-    if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
+    if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0 && rec.startup_wait) {
+      cv::Mat more_u16;  // not mapped yet: they go in with the rest
+      sp.static_depth_m.convertTo(more_u16, CV_16UC1, kDepthUnitsPerM);
+      rec.depth_u16 = cv::max(rec.depth_u16, more_u16);
+    } else if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
       if (backend_->needsPoints()) {
         backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
                          &sp.colors);
@@ -151,7 +167,7 @@ void MappingWorker::secondLookLocked(std::uint64_t id, const cv::Mat& hit, const
   reviseOneLocked(id, cv::Mat(), cv::Mat(), false);  // releases the held data
   rec.rejudge_held = false;
   rec.held_hits.release();
-  if (!keepsDepth()) {
+  if (!keepsDepth() && !rec.startup_wait) {
     rec.depth_u16.release();
     rec.bgr.release();
   }
@@ -159,14 +175,47 @@ void MappingWorker::secondLookLocked(std::uint64_t id, const cv::Mat& hit, const
 
 void MappingWorker::removeSeenThroughWindowLocked(std::size_t begin, std::size_t end) {
   if (!options_.visibility.enabled) return;
-  ScopedStageTimer timer(timings_, "mapping_visibility");
   // Earlier visits' views first (they are older than the window), then the window's.
   std::vector<std::uint64_t> ids =
       revisitContextLocked(records_.at(judge_[(begin + end) / 2]).T_current);
   const std::size_t offset = ids.size();
   ids.insert(ids.end(), judge_.begin(), judge_.end());
-  begin += offset;
-  end += offset;
+  removeSeenThroughLocked(ids, begin + offset, end + offset, options_.visibility);
+}
+
+void MappingWorker::judgeStartupLocked(bool flush) {
+  if (startup_waiting_.empty()) return;
+  const double newest_s = judge_.empty() ? 0.0 : records_.at(judge_.back()).timestamp_s;
+  // Only what later views saw through: the mask votes had their say in the keyframe's window.
+  VisibilityOptions seen_through_only = options_.visibility;
+  seen_through_only.mask_min_views = 0;
+  seen_through_only.mask_span_s = 0.0;
+  seen_through_only.mask_near_px = 0;
+  std::size_t done = 0;
+  for (; done < startup_waiting_.size(); ++done) {
+    const std::uint64_t id = startup_waiting_[done];
+    KeyframeRecord& rec = records_.at(id);
+    if (!flush && rec.timestamp_s > newest_s - options_.startup_window_after_s) break;
+    std::vector<std::uint64_t> ids = revisitContextLocked(rec.T_current);
+    ids.erase(std::remove(ids.begin(), ids.end(), id), ids.end());  // its own view judges not
+    const auto in_window = std::find(judge_.begin(), judge_.end(), id);
+    if (in_window == judge_.end()) ids.push_back(id);
+    ids.insert(ids.end(), judge_.begin(), judge_.end());
+    const auto target =
+        static_cast<std::size_t>(std::find(ids.begin(), ids.end(), id) - ids.begin());
+    removeSeenThroughLocked(ids, target, target + 1, seen_through_only);
+    rec.startup_wait = false;
+    integrateRecordLocked(id);
+    if (in_window == judge_.end() && !keepForRevisitsLocked(rec)) rec.view = VisibilityView();
+  }
+  startup_waiting_.erase(startup_waiting_.begin(),
+                         startup_waiting_.begin() + static_cast<std::ptrdiff_t>(done));
+}
+
+void MappingWorker::removeSeenThroughLocked(const std::vector<std::uint64_t>& ids,
+                                            std::size_t begin, std::size_t end,
+                                            const VisibilityOptions& options) {
+  ScopedStageTimer timer(timings_, "mapping_visibility");
   std::vector<VisibilityKeyframe> keyframes;
   keyframes.reserve(ids.size());
   for (std::size_t i = 0; i < ids.size(); ++i) {
@@ -179,7 +228,7 @@ void MappingWorker::removeSeenThroughWindowLocked(std::size_t begin, std::size_t
     k.timestamp_s = rec.timestamp_s;
     keyframes.push_back(k);
   }
-  VisibilityResult r = removeSeenThrough(camera_, keyframes, options_.visibility);
+  VisibilityResult r = removeSeenThrough(camera_, keyframes, options);
   addVisibilityTimings(r);
   visibility_.elements += r.elements;
   visibility_.seen_through += r.seen_through;

@@ -215,6 +215,7 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   if (records_.emplace(kf.id, std::move(rec)).second) {
     order_.push_back(kf.id);
     if (!deferred()) judge_.push_back(kf.id);
+    if (first_keyframe_s_ < 0.0) first_keyframe_s_ = kf.timestamp_s;
   }
   const auto early = early_updates_.find(kf.id);
   if (early != early_updates_.end()) {

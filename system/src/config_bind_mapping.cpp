@@ -37,6 +37,8 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addInt("mapping.visibility_mask_grow_px", &vis.mask_grow_px, 0, 100);
   schema.addDouble("mapping.window_before_s", &s.window_before_s, 0.0, 1e6);
   schema.addDouble("mapping.window_after_s", &s.window_after_s, 0.0, 1e6);
+  schema.addDouble("mapping.startup_s", &s.startup_s, 0.0, 1e6);
+  schema.addDouble("mapping.startup_window_after_s", &s.startup_window_after_s, 0.0, 1e6);
   schema.addDouble("mapping.window_batch_s", &s.window_batch_s, 0.0, 1e6);
   schema.addInt("mapping.window_revisit_keyframes", &s.window_revisit_keyframes, 0, 1000);
   schema.addDouble("mapping.held_window_after_s", &s.held_window_after_s, 0.0, 1e6);

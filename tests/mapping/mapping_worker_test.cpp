@@ -445,6 +445,45 @@ TEST(MappingWorker, OnlineKeyframesReachTheBackendOnceTheirWindowIsThere) {
   EXPECT_EQ(log.resets, 0);
 }
 
+// The run's first startup_s of keyframes are judged in their window as the others, then once
+// more when the keyframes startup_window_after_s later are there (a mover in view from the first
+// frame is seen through only once it has left), and mapped then; the others are mapped on time.
+TEST(MappingWorker, TheRunsFirstKeyframesAreJudgedAgainBeforeTheyAreMapped) {
+  FakeLog log;
+  log.released = true;
+  StaticPointsOptions options = countingOptions();
+  options.free_space.enabled = false;
+  options.window_after_s = 0.25;
+  options.window_batch_s = 0.0;
+  options.startup_s = 1.0;  // keyframes 0-3 (0.25 s apart)
+  options.startup_window_after_s = 3.0;
+  MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
+                       SyntheticScene::camera(), options, 4, nullptr);
+  std::uint64_t next = 0;
+  const auto pushUpTo = [&](std::uint64_t last) {
+    for (; next <= last; ++next) {
+      auto kf = std::make_shared<KeyframePacket>(*packet(next));
+      kf->timestamp_s = 0.25 * static_cast<double>(next);
+      worker.push(kf);
+    }
+    worker.waitIdle();
+    std::lock_guard<std::mutex> lock(log.mutex);
+    return log.integrated;
+  };
+  EXPECT_EQ(pushUpTo(8), (std::vector<std::uint64_t>{4, 5, 6, 7}));  // 2.0 s
+  std::vector<std::uint64_t> at_3_5 = pushUpTo(14);                   // 3.5 s: 0.0 to 0.5 s
+  std::sort(at_3_5.begin(), at_3_5.end());
+  EXPECT_EQ(std::vector<std::uint64_t>(at_3_5.begin(), at_3_5.begin() + 3),
+            (std::vector<std::uint64_t>{0, 1, 2}));
+  EXPECT_EQ(std::count(at_3_5.begin(), at_3_5.end(), 3u), 0);
+  worker.finish();
+  std::vector<std::uint64_t> all = log.integrated;
+  std::sort(all.begin(), all.end());
+  std::vector<std::uint64_t> expected(15);
+  for (std::uint64_t i = 0; i < 15; ++i) expected[i] = i;
+  EXPECT_EQ(all, expected);
+}
+
 // A backend whose cells are votes over views gets the mask grown by fused_mask_dilation_px (3),
 // a point backend by mask_dilation_px (5): the fusing one receives the ring between them.
 TEST(MappingWorker, FusingBackendsGetTheNarrowerMaskMargin) {

@@ -114,6 +114,10 @@ class MappingWorker {
     bool rejudge_held = false;
     bool supplemented = false;
     cv::Mat held_hits;
+    /// Online, one of the run's first options.startup_s of keyframes: judged in its window, it
+    /// waits for a second visibility judgement once the keyframes
+    /// options.startup_window_after_s later are there, and is integrated then.
+    bool startup_wait = false;
   };
   struct WindowEntry {
     KeyframePacketPtr kf;
@@ -133,6 +137,12 @@ class MappingWorker {
   /// for the judged ones due (all when `flush`), on one set of votes.
   void reviseHeldWindowLocked(std::size_t begin, std::size_t end, bool flush);
   void removeSeenThroughWindowLocked(std::size_t begin, std::size_t end);
+  /// Visibility votes of `ids` (views; earlier visits' first) on the keyframes ids[begin, end).
+  void removeSeenThroughLocked(const std::vector<std::uint64_t>& ids, std::size_t begin,
+                               std::size_t end, const VisibilityOptions& options);
+  /// The startup keyframes' second judgement against the window as it is now, for those whose
+  /// keyframes startup_window_after_s later are there (all when `flush`); integrates them.
+  void judgeStartupLocked(bool flush);
   void integrateRecordLocked(std::uint64_t id);
   /// Unmasks keyframe `id`'s pixels `hit` (held back, confirmed static elsewhere) and remakes its
   /// static depth from `depth_m` (its raw depth); releases its held-revision data unless
@@ -211,6 +221,8 @@ class MappingWorker {
   /// Online: the judgement window in time order; [0, judged_) are judged context.
   std::deque<std::uint64_t> judge_;
   std::size_t judged_ = 0;
+  double first_keyframe_s_ = -1.0;  ///< online: the first keyframe's time (-1: none yet)
+  std::vector<std::uint64_t> startup_waiting_;  ///< online: KeyframeRecord::startup_wait ones
   std::vector<std::uint64_t> revisit_;  ///< online: keyframes whose view is kept for revisits
   std::unordered_map<std::uint64_t, Eigen::Isometry3d> early_updates_;
   std::size_t reintegrated_ = 0;
