@@ -270,12 +270,8 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   if (view == nullptr || depth_m.empty()) return;
   const SeenThroughOptions o = seenThroughOptions(config_);
   // Objects already decided (moving or kept) are fusion's: a kept person is not re-judged here.
-  // Support planes (floor, walls) are no mover's, as for the mover tracks: a floor at a grazing
-  // angle, seen again from another place, looked seen through (crowd x10, played backward).
-  cv::Mat decided = fused.mask | fused.static_objects;
-  if (!evidence.planes.empty()) decided |= evidence.planes;
-  cv::Mat moved = seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view, decided, o,
-                                     &fused.seen_through);
+  cv::Mat moved = seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
+                                     fused.mask | fused.static_objects, o, &fused.seen_through);
   if (fused.seen_through == 0) return;
   if (config_.mask_dilation_px > 0) {
     const int k = 2 * config_.mask_dilation_px + 1;
