@@ -39,10 +39,7 @@ void MappingWorker::judgeReadyLocked(bool flush) {
   }
   for (std::size_t i = judged_; i < end; ++i) {
     KeyframeRecord& rec = records_.at(judge_[i]);
-    const bool startup = options_.visibility.enabled && options_.startup_s > 0.0 &&
-                         options_.startup_window_after_s > options_.window_after_s &&
-                         rec.timestamp_s < first_keyframe_s_ + options_.startup_s;
-    if (startup) {
+    if (waitsForStartupLook(rec)) {
       rec.startup_wait = true;
       startup_waiting_.push_back(judge_[i]);
     } else {
@@ -146,20 +143,20 @@ void MappingWorker::secondLookLocked(std::uint64_t id, const cv::Mat& hit, const
     StaticPoints sp;  // only the pixels this look unmasked
     sp.static_depth_m = staticDepth(depth_m, map_mask, options_);
     sp.static_depth_m.setTo(0.0f, ~fresh);
-    if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0 && rec.startup_wait) {
-      cv::Mat more_u16;  // not mapped yet: they go in with the rest
-      sp.static_depth_m.convertTo(more_u16, CV_16UC1, kDepthUnitsPerM);
-      rec.depth_u16 = cv::max(rec.depth_u16, more_u16);
-    } else if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
-      if (backend_->needsPoints()) {
-        backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
-                         &sp.colors);
+    if (cv::countNonZero(sp.static_depth_m > 0.0f) > 0) {
+      // A startup keyframe waiting for its second judgement is not mapped yet: the pixels go
+      // in with the rest; else now, as its supplement.
+      if (!rec.startup_wait) {
+        if (backend_->needsPoints()) {
+          backProjectDepth(camera_, rec.bgr, sp.static_depth_m, options_.stride, &sp.points_C,
+                           &sp.colors);
+        }
+        backend_->integrate(keyframeView(id | kSupplementBit, rec.timestamp_s, rec.T_current,
+                                         camera_, rec.bgr, sp));
+        rec.supplemented = true;
+        ++supplements_;
       }
-      backend_->integrate(
-          keyframeView(id | kSupplementBit, rec.timestamp_s, rec.T_current, camera_, rec.bgr, sp));
-      rec.supplemented = true;
-      ++supplements_;
-      cv::Mat more_u16;  // a rebuild integrates them with the rest
+      cv::Mat more_u16;  // a rebuild (or the waiting keyframe's mapping) takes them with the rest
       sp.static_depth_m.convertTo(more_u16, CV_16UC1, kDepthUnitsPerM);
       rec.depth_u16 = cv::max(rec.depth_u16, more_u16);
     }
@@ -181,6 +178,12 @@ void MappingWorker::removeSeenThroughWindowLocked(std::size_t begin, std::size_t
   const std::size_t offset = ids.size();
   ids.insert(ids.end(), judge_.begin(), judge_.end());
   removeSeenThroughLocked(ids, begin + offset, end + offset, options_.visibility);
+}
+
+bool MappingWorker::waitsForStartupLook(const KeyframeRecord& rec) const {
+  return options_.visibility.enabled && options_.startup_s > 0.0 &&
+         options_.startup_window_after_s > options_.window_after_s &&
+         rec.timestamp_s < first_keyframe_s_ + options_.startup_s;
 }
 
 void MappingWorker::judgeStartupLocked(bool flush) {

@@ -1,7 +1,8 @@
 #pragma once
 
 // Fusion tests with a still camera: a tracked point every 10 px of a 640 x 480 image, none
-// flagged, and the evidence of a pose (K of freiburg3) with, optionally, each point's id.
+// flagged, and the evidence of a pose (K of freiburg3) with, optionally, each point's id; a
+// person in front of a wall whose points shift sideways.
 
 #include <cstdint>
 #include <vector>
@@ -26,6 +27,33 @@ inline FusionEvidence stillCameraEvidence(std::size_t points, bool with_ids) {
   if (with_ids)
     for (std::size_t i = 0; i < points; ++i) ev.point_ids.push_back(i);
   return ev;
+}
+
+/// A frame with a person 2 m away (kSidewaysPerson) in front of a wall 5 m away: a point every
+/// 10 px, those on him shifted `shift` px sideways (and flagged with `flag_person`), ids in `ev`.
+const cv::Rect kSidewaysPerson(280, 120, 90, 260);
+const Detection kSidewaysPersonBox{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
+
+struct SidewaysFrame {
+  std::vector<cv::Point2f> points;
+  std::vector<std::uint8_t> flags;
+  cv::Mat depth;
+};
+
+inline SidewaysFrame sidewaysFrame(float shift, bool flag_person, FusionEvidence& ev) {
+  SidewaysFrame f;
+  ev.point_ids.clear();
+  for (int y = 5; y < 480; y += 10) {
+    for (int x = 5; x < 640; x += 10) {
+      const bool on = kSidewaysPerson.contains({x, y});
+      f.points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
+      f.flags.push_back(on && flag_person ? 1 : 0);
+      ev.point_ids.push_back(f.points.size() - 1);
+    }
+  }
+  f.depth = cv::Mat(480, 640, CV_32F, cv::Scalar(5.f));
+  f.depth(kSidewaysPerson + cv::Point(cvRound(shift), 0)).setTo(2.f);
+  return f;
 }
 
 }  // namespace dynamap::test

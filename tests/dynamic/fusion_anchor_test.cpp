@@ -89,32 +89,9 @@ TEST(FusionAnchors, APersonSwayingAlongTheLineOfSightIsRarelyKeptAStillOneIs) {
   EXPECT_GT(keptShare(c, 225, stand, true), 0.95);
 }
 
-/// A frame with a person 2 m away (kPerson) in front of a wall 5 m away: a point every 10 px,
-/// those on him shifted `shift` px sideways (and flagged with `flag_person`), ids in `ev`.
-const cv::Rect kPerson(280, 120, 90, 260);
-const Detection kPersonBox{cv::Rect2f(260, 110, 130, 280), 0, 0.9f};
-
-struct SidewaysFrame {
-  std::vector<cv::Point2f> points;
-  std::vector<std::uint8_t> flags;
-  cv::Mat depth;
-};
-
-SidewaysFrame sidewaysFrame(float shift, bool flag_person, FusionEvidence& ev) {
-  SidewaysFrame f;
-  ev.point_ids.clear();
-  for (int y = 5; y < 480; y += 10) {
-    for (int x = 5; x < 640; x += 10) {
-      const bool on = kPerson.contains({x, y});
-      f.points.emplace_back(static_cast<float>(x) + (on ? shift : 0.f), static_cast<float>(y));
-      f.flags.push_back(on && flag_person ? 1 : 0);
-      ev.point_ids.push_back(f.points.size() - 1);
-    }
-  }
-  f.depth = cv::Mat(480, 640, CV_32F, cv::Scalar(5.f));
-  f.depth(kPerson + cv::Point(cvRound(shift), 0)).setTo(2.f);
-  return f;
-}
+using test::sidewaysFrame;
+using test::SidewaysFrame;
+const Detection& kPersonBox = test::kSidewaysPersonBox;
 
 /// Share of `frames` frames in which a person 2 m away, never flagged, whose image shifts
 /// sideways by dx(i) pixels (its tracked points with it), is kept.

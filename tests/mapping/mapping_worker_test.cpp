@@ -415,16 +415,22 @@ TEST(MappingWorker, TheFinalPassIntegratesEachKeyframeOnceWithItsFinalPose) {
   EXPECT_GT(points[1].front(), 1000u);
 }
 
+/// countingOptions() with the judgement window only: a keyframe 0.25 s later, no batching.
+StaticPointsOptions onlineWindowOptions() {
+  StaticPointsOptions options = countingOptions();
+  options.free_space.enabled = false;
+  options.window_after_s = 0.25;
+  options.window_batch_s = 0.0;
+  return options;
+}
+
 // Online, a keyframe goes to the backend once a keyframe window_after_s later has arrived,
 // judged against those within window_before_s before it; a kInPlace backend gets the pose
 // updates of the integrated ones, and the worker keeps no image of theirs.
 TEST(MappingWorker, OnlineKeyframesReachTheBackendOnceTheirWindowIsThere) {
   FakeLog log;
   log.released = true;
-  StaticPointsOptions options = countingOptions();
-  options.free_space.enabled = false;
-  options.window_after_s = 0.25;
-  options.window_batch_s = 0.0;
+  StaticPointsOptions options = onlineWindowOptions();
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
                        SyntheticScene::camera(), options, 4, nullptr);
   for (std::uint64_t id = 0; id < 6; ++id) {
@@ -451,10 +457,7 @@ TEST(MappingWorker, OnlineKeyframesReachTheBackendOnceTheirWindowIsThere) {
 TEST(MappingWorker, TheRunsFirstKeyframesAreJudgedAgainBeforeTheyAreMapped) {
   FakeLog log;
   log.released = true;
-  StaticPointsOptions options = countingOptions();
-  options.free_space.enabled = false;
-  options.window_after_s = 0.25;
-  options.window_batch_s = 0.0;
+  StaticPointsOptions options = onlineWindowOptions();
   options.startup_s = 1.0;  // keyframes 0-3 (0.25 s apart)
   options.startup_window_after_s = 3.0;
   MappingWorker worker(std::make_unique<FakeBackend>(&log, PoseUpdateMode::kInPlace),
@@ -471,7 +474,7 @@ TEST(MappingWorker, TheRunsFirstKeyframesAreJudgedAgainBeforeTheyAreMapped) {
     return log.integrated;
   };
   EXPECT_EQ(pushUpTo(8), (std::vector<std::uint64_t>{4, 5, 6, 7}));  // 2.0 s
-  std::vector<std::uint64_t> at_3_5 = pushUpTo(14);                   // 3.5 s: 0.0 to 0.5 s
+  std::vector<std::uint64_t> at_3_5 = pushUpTo(14);                  // 3.5 s: 0.0 to 0.5 s
   std::sort(at_3_5.begin(), at_3_5.end());
   EXPECT_EQ(std::vector<std::uint64_t>(at_3_5.begin(), at_3_5.begin() + 3),
             (std::vector<std::uint64_t>{0, 1, 2}));

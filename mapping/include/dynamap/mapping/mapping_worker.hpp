@@ -140,6 +140,9 @@ class MappingWorker {
   /// Visibility votes of `ids` (views; earlier visits' first) on the keyframes ids[begin, end).
   void removeSeenThroughLocked(const std::vector<std::uint64_t>& ids, std::size_t begin,
                                std::size_t end, const VisibilityOptions& options);
+  /// True if `rec`, judged in its window, is one of the run's first startup_s of keyframes that
+  /// wait for their second judgement (KeyframeRecord::startup_wait).
+  bool waitsForStartupLook(const KeyframeRecord& rec) const;
   /// The startup keyframes' second judgement against the window as it is now, for those whose
   /// keyframes startup_window_after_s later are there (all when `flush`); integrates them.
   void judgeStartupLocked(bool flush);
