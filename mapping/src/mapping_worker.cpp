@@ -196,7 +196,8 @@ void MappingWorker::integratePacket(const KeyframePacket& kf, const cv::Mat& ext
   staticDepth(kf.depth_m, mask, options_).convertTo(rec.depth_u16, CV_16UC1, kDepthUnitsPerM);
   rec.bgr = kf.bgr;  // shared, immutable packet data
   if (options_.visibility.enabled)
-    rec.view = makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility);
+    rec.view =
+        makeVisibilityView(kf.depth_m, kf.dynamic_mask, options_.visibility, kf.moved_object_mask);
   if (options_.held_revision_voxel_m > 0.0) {
     const int stride = heldStridePx(camera_, options_.held_revision_voxel_m);
     rec.held.confirmed_C = maskPoints(camera_, kf.depth_m, kf.confirmed_mask, stride);

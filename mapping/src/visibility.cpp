@@ -10,9 +10,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "dynamap/mapping/in_two.hpp"
 #include "dynamap/mapping/radix_sort.hpp"
 #include "dynamap/mapping/static_points.hpp"
-#include "dynamap/mapping/in_two.hpp"
 #include "visibility_table.hpp"
 
 namespace dynamap {
@@ -201,10 +201,21 @@ std::size_t zeroRemoved(const VisibilityKeyframe& kf, const RunElements& runs,
   return zeroed;
 }
 
+/// 255 where at least half of a block of `mask` (grown by grow_px) is set; empty without a
+/// mask of the image's size.
+cv::Mat movingBlocks(const cv::Mat& mask, const cv::Size& image, const cv::Size& blocks,
+                     int grow_px) {
+  if (mask.size() != image || mask.type() != CV_8UC1) return {};
+  cv::Mat share;  // block mean of the moving pixels
+  cv::resize(dilatedMask(mask, grow_px), share, blocks, 0, 0, cv::INTER_AREA);
+  return share >= 128;
+}
+
 }  // namespace
 
 VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
-                                  const VisibilityOptions& options) {
+                                  const VisibilityOptions& options,
+                                  const cv::Mat& moved_object_mask) {
   VisibilityView view;
   view.downsample = std::max(1, options.downsample);
   if (depth_m.empty()) return view;
@@ -225,12 +236,9 @@ VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic
   cv::erode(block, block, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
   block.setTo(0.0f, block >= kNoReading);
   view.near_m = block;
-  if (dynamic_mask.size() == depth_m.size() && dynamic_mask.type() == CV_8UC1) {
-    const cv::Mat moving = dilatedMask(dynamic_mask, options.mask_grow_px);
-    cv::Mat share;  // block mean of the moving pixels
-    cv::resize(moving, share, block.size(), 0, 0, cv::INTER_AREA);
-    view.moving = share >= 128;
-  }
+  view.moving = movingBlocks(dynamic_mask, depth_m.size(), block.size(), options.mask_grow_px);
+  view.moved_objects =
+      movingBlocks(moved_object_mask, depth_m.size(), block.size(), options.mask_grow_px);
   return view;
 }
 

@@ -34,10 +34,14 @@ struct Element {
 /// it did so within options.mask_span_s, and at least mask_span_view_ratio times as many had it
 /// in view (something else in front, or the surface behind it within the margin).
 inline bool seenBriefly(const Element& e, const VisibilityOptions& options,
-                        const std::vector<double>& stamps) {
+                        const std::vector<double>& stamps, double view_ratio) {
   if (options.mask_span_s <= 0.0 || e.observed == 0 || e.last >= stamps.size()) return false;
   return stamps[e.last] - stamps[e.first] <= options.mask_span_s &&
-         e.in_view >= options.mask_span_view_ratio * e.observed;
+         e.in_view >= view_ratio * e.observed;
+}
+inline bool seenBriefly(const Element& e, const VisibilityOptions& options,
+                        const std::vector<double>& stamps) {
+  return seenBriefly(e, options, stamps, options.mask_span_view_ratio);
 }
 
 /// A mover that stood still for a moment (a foot during a step): seen briefly, and by some
@@ -49,7 +53,10 @@ inline bool briefUnderMask(const Element& e, const VisibilityOptions& options,
 
 /// The beside-a-mover rule (options.mask_near_px, mask_near_depth_m): an element that a single
 /// keyframe (up to options.mask_near_max_views) saw, unmasked, seen briefly, and that a keyframe
-/// within options.mask_span_s saw with moving blocks near its projection and near its depth.
+/// within options.mask_span_s saw with moving blocks near its projection and near its depth; or,
+/// where those blocks are a moved object's (not a person's), one seen briefly by
+/// mask_near_object_view_ratio that up to options.mask_near_object_max_views saw unmasked or
+/// some keyframe saw under its mask (the brief rule's case, with that ratio).
 class BesideMover {
  public:
   BesideMover(const PinholeCamera& camera, const std::vector<VisibilityKeyframe>& keyframes,
@@ -61,22 +68,33 @@ class BesideMover {
   }
 
   bool holds(const Element& e, const Eigen::Vector3f& centroid) const {
-    if (T_C_W_.empty() || e.observed > options_.mask_near_max_views || e.masked != 0 ||
-        !seenBriefly(e, options_, stamps_))
-      return false;
+    if (T_C_W_.empty()) return false;
+    if (e.masked == 0 && e.observed <= options_.mask_near_max_views &&
+        seenBriefly(e, options_, stamps_) && moverNear(e, centroid, &VisibilityView::moving))
+      return true;
+    const int object_views = options_.mask_near_object_max_views;
+    return object_views > 0 && (e.masked != 0 || e.observed <= object_views) &&
+           seenBriefly(e, options_, stamps_, options_.mask_near_object_view_ratio) &&
+           moverNear(e, centroid, &VisibilityView::moved_objects);
+  }
+
+ private:
+  using Blocks = cv::Mat VisibilityView::*;
+
+  /// A keyframe within mask_span_s of the first that saw e has `blocks` beside it.
+  bool moverNear(const Element& e, const Eigen::Vector3f& centroid, Blocks blocks) const {
     const double t = stamps_[e.first];
-    std::size_t j = e.first;  // the keyframes within mask_span_s of the one that saw it
+    std::size_t j = e.first;
     while (j > 0 && t - stamps_[j - 1] <= options_.mask_span_s) --j;
     for (; j < stamps_.size() && stamps_[j] - t <= options_.mask_span_s; ++j) {
-      if (moverBeside(j, centroid)) return true;
+      if (moverBeside(j, centroid, blocks)) return true;
     }
     return false;
   }
 
- private:
-  bool moverBeside(std::size_t j, const Eigen::Vector3f& centroid) const {
+  bool moverBeside(std::size_t j, const Eigen::Vector3f& centroid, Blocks blocks) const {
     const VisibilityView* view = keyframes_[j].view;
-    if (view == nullptr || view->moving.size() != view->near_m.size()) return false;
+    if (view == nullptr || (view->*blocks).size() != view->near_m.size()) return false;
     const Eigen::Vector3f p = T_C_W_[j] * centroid;
     if (p.z() < kMinDepthM) return false;
     const double s = 1.0 / view->downsample;
@@ -91,7 +109,7 @@ class BesideMover {
     const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
     for (int y = std::max(0, v0 - reach); y <= std::min(near.rows - 1, v0 + reach); ++y) {
       const float* depth = near.ptr<float>(y);
-      const std::uint8_t* moving = view->moving.ptr<std::uint8_t>(y);
+      const std::uint8_t* moving = (view->*blocks).ptr<std::uint8_t>(y);
       for (int x = std::max(0, u0 - reach); x <= std::min(near.cols - 1, u0 + reach); ++x) {
         if (moving[x] != 0 && depth[x] > 0.0f && depth[x] >= lo && depth[x] <= hi) return true;
       }

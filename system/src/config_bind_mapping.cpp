@@ -34,6 +34,10 @@ void bindMappingConfig(ConfigSchema& schema, MappingConfig& c) {
   schema.addInt("mapping.visibility_mask_near_px", &vis.mask_near_px, 0, 1000);
   schema.addDouble("mapping.visibility_mask_near_depth_m", &vis.mask_near_depth_m, 0.0, 100.0);
   schema.addInt("mapping.visibility_mask_near_max_views", &vis.mask_near_max_views, 1, 1000);
+  schema.addInt("mapping.visibility_mask_near_object_max_views", &vis.mask_near_object_max_views, 0,
+                1000);
+  schema.addDouble("mapping.visibility_mask_near_object_view_ratio",
+                   &vis.mask_near_object_view_ratio, 0.0, 1e6);
   schema.addInt("mapping.visibility_mask_grow_px", &vis.mask_grow_px, 0, 100);
   schema.addDouble("mapping.window_before_s", &s.window_before_s, 0.0, 1e6);
   schema.addDouble("mapping.window_after_s", &s.window_after_s, 0.0, 1e6);

@@ -330,5 +330,23 @@ TEST(FusionOverTime, AMoverTrackEndsWhereItGrowsOverProvenStaticPoints) {
   EXPECT_EQ(unproven_objects, 1u);
 }
 
+// The mask's part on moved objects that are not people (FusionResult::moved_objects, what
+// mapping's votes reach further beside): a class-less mover's pixels, not a walker's.
+TEST(FusionOverTime, MovedObjectsHoldAMoversPixelsNotAPersons) {
+  Scene s;
+  const cv::Rect person(100, 150, 80, 250), thing(400, 250, 120, 120);
+  s.place(person, 2.f);
+  s.place(thing, 1.5f);
+  DynamicConfig c;
+  RegionFusion fusion(c, ClassTable(c));
+  const Detection mover{cv::Rect2f(thing), ClassTable::kMover, 1.f};
+  const FusionResult r =
+      fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.quiet, {box(person), mover});
+  EXPECT_GT(maskedShare(r.mask, person), 0.9);  // both new, both masked
+  EXPECT_GT(maskedShare(r.mask, thing), 0.9);
+  EXPECT_GT(maskedShare(r.moved_objects, thing), 0.9);
+  EXPECT_LT(maskedShare(r.moved_objects, person), 0.01);
+}
+
 }  // namespace
 }  // namespace dynamap::fusion_time_test

@@ -14,19 +14,21 @@ namespace dynamap::test {
 
 class VisibilityPass {
  public:
-  /// The next keyframe: its frame and the dynamic mask the pass sees.
-  void add(SyntheticFrame frame, const cv::Mat& mask) {
+  /// The next keyframe: its frame and the dynamic mask the pass sees; with `moved_object` the
+  /// mask is a moved object's (not a person's: KeyframePacket::moved_object_mask).
+  void add(SyntheticFrame frame, const cv::Mat& mask, bool moved_object = false) {
     depths_.push_back(frame.depth_m.clone());
     depths_.back().setTo(0.0f, mask);  // static depth: masked pixels 0, edited by the pass
     frames_.push_back(std::move(frame));
     masks_.push_back(mask);
+    object_masks_.push_back(moved_object ? mask : cv::Mat());
   }
 
   /// Runs the pass over the keyframes added, period_s apart.
   void run(const VisibilityOptions& options, double period_s) {
     std::vector<VisibilityView> views;
     for (std::size_t k = 0; k < frames_.size(); ++k)
-      views.push_back(makeVisibilityView(frames_[k].depth_m, masks_[k], options));
+      views.push_back(makeVisibilityView(frames_[k].depth_m, masks_[k], options, object_masks_[k]));
     std::vector<VisibilityKeyframe> kfs;
     for (std::size_t k = 0; k < frames_.size(); ++k) {
       VisibilityKeyframe kf{&depths_[k], 1.0, frames_[k].T_W_C, &views[k]};
@@ -54,6 +56,7 @@ class VisibilityPass {
  private:
   std::vector<SyntheticFrame> frames_;
   std::vector<cv::Mat> masks_;
+  std::vector<cv::Mat> object_masks_;
   std::vector<cv::Mat> depths_;
   VisibilityResult result_;
 };

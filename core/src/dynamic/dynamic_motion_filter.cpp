@@ -78,6 +78,8 @@ MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
   if (!fused.held.empty() && cv::countNonZero(fused.held) > 0) out.held_mask = fused.held;
   if (!fused.confirmed.empty() && cv::countNonZero(fused.confirmed) > 0)
     out.confirmed_mask = fused.confirmed;
+  if (!fused.moved_objects.empty() && cv::countNonZero(fused.moved_objects) > 0)
+    out.moved_object_mask = fused.moved_objects;
   if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
   return out;
 }

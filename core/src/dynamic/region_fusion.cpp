@@ -115,6 +115,7 @@ struct RegionFusion::Frame {
   cv::Mat claimed;    ///< pixels of detected objects (clusters do not grow into them)
   cv::Mat movers;     ///< pixels of moving movers (ClassTable::kMover): geometry saw them move
   cv::Mat people;     ///< pixels of detected high-dynamic objects (no mover takes them)
+  cv::Mat things;     ///< pixels of moving objects that are not people (movers, a pushed chair)
 };
 
 RegionFusion::RegionFusion(const DynamicConfig& config, const ClassTable& classes)
@@ -238,6 +239,7 @@ void RegionFusion::applyObject(Frame& f, ObjectDecision& d, cv::Mat& region, con
   };
   add(d.moving ? result.mask : result.static_objects);
   if (d.moving && mover) add(f.movers);
+  if (d.moving && (mover || !classes_.isHighDynamic(d.detection.class_id))) add(f.things);
   if (d.moving) add(d.unconfirmed ? result.unconfirmed : f.certain);
   if (d.moving) add(d.motion_now || f.mode != FusionMode::kBoth ? f.evidenced : result.held);
   if (!d.moving && d.quiet_frames >= config_.static_confirm_frames) add(f.confirmed);
@@ -365,6 +367,8 @@ void RegionFusion::finishMasks(Frame& f, FusionResult& result) const {
   }
   result.unconfirmed.setTo(0, f.certain | f.confirmed);
   result.confirmed = f.confirmed;
+  result.moved_objects = f.things & result.mask;
+  result.moved_objects.setTo(0, f.people);
   if (config_.mask_dilation_px > 0 && cv::countNonZero(result.mask) > 0) {
     const int k = 2 * config_.mask_dilation_px + 1;
     const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k});
@@ -383,7 +387,7 @@ FusionResult RegionFusion::fuse(FusionMode mode, const cv::Mat& depth_m,
                                 const FusionEvidence& evidence) {
   const auto zeros = [&depth_m] { return cv::Mat(cv::Mat::zeros(depth_m.size(), CV_8UC1)); };
   Frame f{mode,    depth_m, points,  dyn,     evidence, zeros(),
-          zeros(), zeros(), zeros(), zeros(), zeros()};
+          zeros(), zeros(), zeros(), zeros(), zeros(),  zeros()};
   FusionResult result = emptyResult(depth_m.size());
   std::vector<ObjectTrack> next;
   if (mode != FusionMode::kGeometry) {

@@ -236,6 +236,7 @@ KeyframePacketPtr Tracker::Impl::createKeyframe(const RgbdFrame& frame, const cv
   packet->dynamic_mask = filtered.dynamic_mask.clone();
   if (!packet->dynamic_mask.empty()) packet->held_mask = filtered.held_mask.clone();
   packet->confirmed_mask = filtered.confirmed_mask.clone();
+  packet->moved_object_mask = filtered.moved_object_mask.clone();
   return packet;
 }
 

@@ -41,6 +41,9 @@ struct KeyframePacket {
   /// unmasks held pixels where another keyframe confirmed an object static.
   cv::Mat held_mask;
   cv::Mat confirmed_mask;
+  /// CV_8UC1, may be empty (MotionFilterOutput::moved_object_mask): the part of dynamic_mask on
+  /// moving objects that are not people.
+  cv::Mat moved_object_mask;
 };
 using KeyframePacketPtr = std::shared_ptr<const KeyframePacket>;
 

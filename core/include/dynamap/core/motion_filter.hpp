@@ -53,6 +53,9 @@ struct MotionFilterOutput {
   /// static over time. They reach KeyframePacket for mapping to judge in hindsight.
   cv::Mat held_mask;
   cv::Mat confirmed_mask;
+  /// CV_8UC1 (may be empty): the part of dynamic_mask on moving objects that are not people
+  /// (FusionResult::moved_objects), for mapping's votes.
+  cv::Mat moved_object_mask;
 };
 
 /// Hook between feature matching and pose estimation. The tracker drops dynamic matches and

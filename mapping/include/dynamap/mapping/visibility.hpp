@@ -39,6 +39,14 @@ struct VisibilityOptions {
   /// The rule's "a single keyframe": up to this many (a mover seen by the first keyframes of a
   /// run before anything found it moving, and hidden behind itself afterwards).
   int mask_near_max_views = 1;
+  /// Beside a moved object that is not a person (VisibilityView::moved_objects: a pushed chair,
+  /// a cart), the rule takes surfaces up to this many keyframes saw unmasked, and any that a
+  /// keyframe saw under its mask, seen briefly by mask_near_object_view_ratio instead of
+  /// mask_span_view_ratio: an object moving from the run's first frame, or into the view, leaves
+  /// its first places in the keyframes before anything found it, and is itself in front of them
+  /// afterwards, so no view sees them empty (0 = off: the rules as above).
+  int mask_near_object_max_views = 3;
+  double mask_near_object_view_ratio = 1.0;
   /// The dynamic mask is grown by this radius (px) before its blocks are judged: the margin
   /// that a keyframe's mask keeps off the background (mapping.mask_margin_behind_m) still
   /// counts for the votes of what lies at a mover's outline.
@@ -50,14 +58,17 @@ struct VisibilityOptions {
 /// 160 x 120 float image for 640 x 480 and downsample 4: 77 KB). The window makes depth edges
 /// and small pose errors count as "not seen through".
 struct VisibilityView {
-  cv::Mat near_m;  ///< CV_32FC1, 0 = no reading in the window
-  cv::Mat moving;  ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
+  cv::Mat near_m;         ///< CV_32FC1, 0 = no reading in the window
+  cv::Mat moving;         ///< CV_8UC1, 255 = at least half the block under the mask; may be empty
+  cv::Mat moved_objects;  ///< the same of moved objects that are not people; may be empty
   int downsample = 1;
 };
 
-/// dynamic_mask: CV_8UC1, 255 = moving (as extractStaticPoints()), or empty.
+/// dynamic_mask: CV_8UC1, 255 = moving (as extractStaticPoints()), or empty; moved_object_mask
+/// its part on moving objects that are not people (KeyframePacket::moved_object_mask), or empty.
 VisibilityView makeVisibilityView(const cv::Mat& depth_m, const cv::Mat& dynamic_mask,
-                                  const VisibilityOptions& options);
+                                  const VisibilityOptions& options,
+                                  const cv::Mat& moved_object_mask = cv::Mat());
 
 /// One keyframe for the visibility pass: its static depth (what goes into the map; removed
 /// pixels are set to 0 in place), its final pose and its view.
@@ -90,8 +101,9 @@ struct VisibilityResult {
 /// keyframe's static depth. So is a voxel that most keyframes seeing it saw under their
 /// dynamic mask (options.mask_min_views, mask_ratio), one that a keyframe saw under its mask
 /// and all keyframes saw only within a short time (options.mask_span_s, mask_span_view_ratio;
-/// keyframes must come in time order), and one that a single keyframe saw beside a mover
-/// (options.mask_near_px). Anything that every visit saw (a
+/// keyframes must come in time order), and one that a single keyframe (up to
+/// mask_near_object_max_views beside a moved object) saw beside a mover (options.mask_near_px).
+/// Anything that every visit saw (a
 /// standing person, the teddy) stays. Cost: one projection of the voxel centroids per keyframe, no
 /// point pairs. Runs on two threads (keyframes keyed four at a time, whichever thread is free,
 /// and added in their order; the element table in two parts by the parity of the voxel key,

@@ -23,10 +23,10 @@ enum class FusionMode : std::uint8_t {
 /// What fusion decided about one detection in the current frame.
 struct ObjectDecision {
   Detection detection;
-  double weight = 0.0;      ///< class motion prior
-  int points = 0;           ///< tracked points on the object's own pixels
-  int dynamic_points = 0;   ///< of which dynamic
-  int proven_points = 0;    ///< of which landmarks the pose from proven-static ones held
+  double weight = 0.0;     ///< class motion prior
+  int points = 0;          ///< tracked points on the object's own pixels
+  int dynamic_points = 0;  ///< of which dynamic
+  int proven_points = 0;   ///< of which landmarks the pose from proven-static ones held
   /// A person's box (a high-dynamic detection) covers much of its box: its points and flags
   /// may be the person's (a walker passing in front of a chair).
   bool under_person = false;
@@ -87,6 +87,10 @@ struct FusionResult {
   cv::Mat held;
   /// CV_8UC1, 255 = pixels of objects confirmed static over time (static_confirm_frames).
   cv::Mat confirmed;
+  /// CV_8UC1, 255 = masked pixels of moving objects that are not people: class-less movers
+  /// and moved objects of the detector's other classes (a pushed chair). Mapping's vote on what
+  /// a mover left unmasked before anything found it reaches further beside these.
+  cv::Mat moved_objects;
   std::vector<ObjectDecision> objects;
   int clusters = 0;      ///< dynamic-point clusters grown into regions outside objects
   int seen_through = 0;  ///< regions the dense check added (DynamicMotionFilter)
