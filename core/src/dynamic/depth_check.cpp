@@ -169,13 +169,14 @@ cv::Mat depthSteps(const cv::Mat& depth_m, double step_m) {
 
 cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                            const DepthView& view, const cv::Mat& exclude,
-                           const SeenThroughOptions& o, int* regions) {
+                           const SeenThroughOptions& o, int* regions, const cv::Mat& not_seeds) {
   cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (regions != nullptr) *regions = 0;
   cv::Mat seen = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   compareWithView(depth_m, cv::Mat(), cv::Rect(0, 0, depth_m.cols, depth_m.rows), T_W_C, K, view,
                   o.check, &seen);
   if (!exclude.empty()) seen.setTo(0, exclude);
+  if (!not_seeds.empty()) seen.setTo(0, not_seeds);
   // Groups are found only where there is anything (most frames see through little or nothing);
   // each group is handled on its own, so the order of their labels does not matter.
   const cv::Rect bound = cv::boundingRect(seen);

@@ -84,6 +84,12 @@ MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
   return out;
 }
 
+SupportPlaneOptions supportPlaneOptions(const DynamicConfig& c) {
+  SupportPlaneOptions o;
+  o.max_planes = c.support_planes;
+  return o;
+}
+
 SeenThroughOptions seenThroughOptions(const DynamicConfig& c) {
   SeenThroughOptions o;
   o.min_region_px = c.dense_min_region_px;
@@ -272,8 +278,11 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   if (view == nullptr || depth_m.empty()) return;
   const SeenThroughOptions o = seenThroughOptions(config_);
   // Objects already decided (moving or kept) are fusion's: a kept person is not re-judged here.
-  cv::Mat moved = seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
-                                     fused.mask | fused.static_objects, o, &fused.seen_through);
+  const cv::Mat still_planes = stillPlaneCells(depth_m, evidence.T_W_C, evidence.K, *view, planes_,
+                                               supportPlaneOptions(config_), o.check);
+  cv::Mat moved =
+      seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
+                         fused.mask | fused.static_objects, o, &fused.seen_through, still_planes);
   if (fused.seen_through == 0) return;
   if (config_.mask_dilation_px > 0) {
     const int k = 2 * config_.mask_dilation_px + 1;
@@ -317,6 +326,7 @@ void DynamicMotionFilter::addMovers(const cv::Mat& depth_m, const FusionEvidence
 
 cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
                                                 const std::vector<Detection>& dets) {
+  planes_.clear();
   if (config_.support_planes <= 0 || depth_m.empty() || mode_ == FusionMode::kDetector) return {};
   const auto start = Clock::now();
   cv::Mat exclude =
@@ -325,9 +335,9 @@ cv::Mat DynamicMotionFilter::supportPlanePixels(const cv::Mat& depth_m,
     const cv::Rect box = cv::Rect(d.box) & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
     if (box.area() > 0) exclude(box).setTo(255);
   }
-  SupportPlaneOptions o;
-  o.max_planes = config_.support_planes;
-  cv::Mat on_plane = planePixels(depth_m, K_, findSupportPlanes(depth_m, K_, exclude, o), o);
+  const SupportPlaneOptions o = supportPlaneOptions(config_);
+  planes_ = findSupportPlanes(depth_m, K_, exclude, o);
+  cv::Mat on_plane = planePixels(depth_m, K_, planes_, o);
   record("support_planes", msSince(start));
   return on_plane;
 }

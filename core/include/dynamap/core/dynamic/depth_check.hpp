@@ -37,7 +37,7 @@ struct DepthCheckOptions {
   /// ... and this share of the depth, for the sensor's low-frequency depth distortion (a few
   /// centimetres at 3 m towards the image borders on a Kinect).
   double relative_margin = 0.02;
-  int border_px = 16;  ///< pixels this close to the image border are not sampled
+  int border_px = 16;        ///< pixels this close to the image border are not sampled
   double max_depth_m = 0.0;  ///< pixels with a deeper current depth are not sampled (0 = any)
 };
 
@@ -92,9 +92,11 @@ cv::Mat depthSteps(const cv::Mat& depth_m, double step_m);
 /// `exclude`). A surface that only appeared from behind something (the
 /// camera moved) is not seen through: `view` saw the occluder in front of it. CV_8UC1, 255 =
 /// moved; *regions = the number of groups kept.
+/// `not_seeds` (CV_8UC1, may be empty): pixels that start no group but may be grown into.
 cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                            const DepthView& view, const cv::Mat& exclude,
-                           const SeenThroughOptions& options, int* regions = nullptr);
+                           const SeenThroughOptions& options, int* regions = nullptr,
+                           const cv::Mat& not_seeds = cv::Mat());
 
 /// The depth of the last frames with their poses, kept at half resolution, to compare the
 /// current frame with an earlier one. Not thread-safe (one caller).

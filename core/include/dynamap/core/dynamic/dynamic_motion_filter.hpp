@@ -11,6 +11,7 @@
 #include "dynamap/core/dynamic/epipolar_check.hpp"
 #include "dynamap/core/dynamic/object_detector.hpp"
 #include "dynamap/core/dynamic/region_fusion.hpp"
+#include "dynamap/core/dynamic/support_planes.hpp"
 #include "dynamap/core/dynamic_config.hpp"
 #include "dynamap/core/motion_filter.hpp"
 #include "dynamap/core/timing.hpp"
@@ -75,7 +76,8 @@ class DynamicMotionFilter : public MotionFilter {
   /// frame's input brings (input.has_prior).
   void keepLastDepth(const MotionFilterInput& input);
   /// The dense check (DynamicConfig::dense_check_frames): what the frame that many frames back
-  /// saw through, outside fusion's objects, is added to the mask.
+  /// saw through, outside fusion's objects, is added to the mask. No group starts on a support
+  /// plane that the view saw at the same place (stillPlaneCells()), but groups grow into them.
   void addSeenThrough(const cv::Mat& depth_m, const FusionEvidence& evidence, FusionResult& fused);
   /// DynamicConfig::mover_tracks, in mode both.
   bool moverTracks() const;
@@ -132,6 +134,7 @@ class DynamicMotionFilter : public MotionFilter {
   cv::Mat prev_kept_movers_;  ///< last frame's movers decided static (none is found there)
   std::vector<Detection> prev_people_;   ///< last frame's high-dynamic objects (no mover there)
   std::vector<Detection> prev_walkers_;  ///< ... those of them that were moving
+  std::vector<Plane> planes_;            ///< this frame's support planes (camera frame)
   /// Recent frames with their final poses (DynamicConfig::dense_check_frames). The last frame
   /// waits in pending_ until the next filter() call brings its final pose.
   DepthHistory depth_history_;

@@ -4,6 +4,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "dynamap/core/dynamic/depth_check.hpp"
+
 namespace dynamap {
 
 /// A plane n . p_C + d = 0 in the camera frame, |n| = 1.
@@ -39,5 +41,16 @@ std::vector<Plane> findSupportPlanes(const cv::Mat& depth_m, const cv::Vec4d& K,
 /// that margin, so these pixels are no object's own.
 cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vector<Plane>& planes,
                     const SupportPlaneOptions& options);
+
+/// The sampled pixels (check.stride_px, as compareWithView()) of `planes` whose plane `view`
+/// (an earlier depth with its pose) saw standing still: projected into the view, each meets there
+/// a surface whose point lies on the pixel's own plane within the check's margin. CV_8UC1 of the
+/// depth's size, 255 = the sample's stride x stride cell. A floor seen at a grazing angle from
+/// another place can look seen through along the rays (a small pose error moves the depth there
+/// a lot) while every point the view saw still lies on it; a panel slid along a wall is seen
+/// through at its leading edge, where the view saw the wall, far off the panel's plane.
+cv::Mat stillPlaneCells(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
+                        const DepthView& view, const std::vector<Plane>& planes,
+                        const SupportPlaneOptions& plane_options, const DepthCheckOptions& check);
 
 }  // namespace dynamap
