@@ -66,8 +66,8 @@ TEST(StillPlanes, AFloorThatAPoseErrorMakesLookSeenThroughStartsNoGroup) {
   EXPECT_GT(cv::countNonZero(seen & still), 0.95 * cv::countNonZero(seen));
   SeenThroughOptions so;
   const cv::Mat before = seenThroughRegions(depth, cv::Matx44d::eye(), kK, view, cv::Mat(), so);
-  const cv::Mat after =
-      seenThroughRegions(depth, cv::Matx44d::eye(), kK, view, cv::Mat(), so, nullptr, still);
+  const cv::Mat after = seenThroughRegions(depth, cv::Matx44d::eye(), kK, view, cv::Mat(), so,
+                                           nullptr, [&](const cv::Mat&) { return still; });
   EXPECT_GT(cv::countNonZero(before & floor), 5000);
   EXPECT_EQ(cv::countNonZero(after), 0);
 }
@@ -88,8 +88,9 @@ TEST(StillPlanes, APanelSlidAlongAWallIsStillFoundAtItsLeadingEdge) {
       stillPlaneCells(depth, cv::Matx44d::eye(), kK, view, planes, po, DepthCheckOptions());
   EXPECT_LT(cv::countNonZero(still & seen), 0.02 * cv::countNonZero(seen));
   EXPECT_GT(cv::countNonZero(still & panel & ~edge), 0.9 * cv::countNonZero(panel & ~edge));
-  const cv::Mat moved = seenThroughRegions(depth, cv::Matx44d::eye(), kK, view, cv::Mat(),
-                                           SeenThroughOptions(), nullptr, still);
+  const cv::Mat moved =
+      seenThroughRegions(depth, cv::Matx44d::eye(), kK, view, cv::Mat(), SeenThroughOptions(),
+                         nullptr, [&](const cv::Mat&) { return still; });
   EXPECT_GT(cv::countNonZero(moved & edge), 0.95 * cv::countNonZero(edge));
   EXPECT_GT(cv::countNonZero(moved & panel), 0.7 * cv::countNonZero(panel));
 }

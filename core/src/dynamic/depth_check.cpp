@@ -53,6 +53,19 @@ double groupDepth(const cv::Mat& depth_m, const cv::Mat& labels, cv::Point origi
 
 }  // namespace
 
+double agreementMarginM(double z_m, const DepthCheckOptions& o) {
+  return o.noise_sigmas * std::sqrt(2.0) * depthNoiseM(z_m) + o.pose_margin_m +
+         o.relative_margin * z_m;
+}
+
+bool viewPixel(const cv::Vec4d& p_V, const cv::Vec4d& K, const DepthView& view, int* u, int* v) {
+  if (p_V[2] <= 0.1) return false;
+  const double sv = view.scale;
+  *u = cvRound(sv * (K[0] * p_V[0] / p_V[2] + K[2] + 0.5) - 0.5);
+  *v = cvRound(sv * (K[1] * p_V[1] / p_V[2] + K[3] + 0.5) - 0.5);
+  return *u >= 0 && *v >= 0 && *u < view.depth_m.cols && *v < view.depth_m.rows;
+}
+
 float interiorDepth(const cv::Mat& depth_m, int x, int y) {
   const float z = depth_m.at<float>(y, x);
   if (z <= 0.f) return 0.f;
@@ -86,12 +99,10 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
   DepthAgreement out;
   if (view.depth_m.empty() || depth_m.empty()) return out;
   const cv::Matx44d T_V_C = view.T_W_C.inv(cv::DECOMP_SVD) * T_W_C;
-  const double sv = view.scale;
-  const int slack = std::max(1, cvRound(o.slack_px * sv));
+  const int slack = std::max(1, cvRound(o.slack_px * view.scale));
   const int b = std::max(0, o.border_px);
   const cv::Rect r = roi & cv::Rect(b, b, depth_m.cols - 2 * b, depth_m.rows - 2 * b);
   const int step = std::max(1, o.stride_px);
-  const double k_sigma = o.noise_sigmas * std::sqrt(2.0);
   for (int y = r.y + step / 2; y < r.y + r.height; y += step) {
     for (int x = r.x + step / 2; x < r.x + r.width; x += step) {
       if (!region.empty() && region.at<uchar>(y, x) == 0) continue;
@@ -99,13 +110,10 @@ DepthAgreement compareWithView(const cv::Mat& depth_m, const cv::Mat& region, co
       if (z <= 0.f || (o.max_depth_m > 0.0 && z > o.max_depth_m)) continue;
       const cv::Vec4d p_C((x - K[2]) / K[0] * z, (y - K[3]) / K[1] * z, z, 1.0);
       const cv::Vec4d p_V = T_V_C * p_C;
-      if (p_V[2] <= 0.1) continue;
-      const int u = cvRound(sv * (K[0] * p_V[0] / p_V[2] + K[2] + 0.5) - 0.5);
-      const int v = cvRound(sv * (K[1] * p_V[1] / p_V[2] + K[3] + 0.5) - 0.5);
-      if (u < 0 || v < 0 || u >= view.depth_m.cols || v >= view.depth_m.rows) continue;
+      int u = 0, v = 0;
+      if (!viewPixel(p_V, K, view, &u, &v)) continue;
       const double zv = p_V[2];
-      const auto margin =
-          static_cast<float>(k_sigma * depthNoiseM(zv) + o.pose_margin_m + o.relative_margin * zv);
+      const auto margin = static_cast<float>(agreementMarginM(zv, o));
       const Verdict verdict = judge(view.depth_m, u, v, slack, static_cast<float>(zv), margin);
       if (verdict == Verdict::kNone) continue;
       ++out.samples;
@@ -169,17 +177,21 @@ cv::Mat depthSteps(const cv::Mat& depth_m, double step_m) {
 
 cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                            const DepthView& view, const cv::Mat& exclude,
-                           const SeenThroughOptions& o, int* regions, const cv::Mat& not_seeds) {
+                           const SeenThroughOptions& o, int* regions, const SeedFilter& not_seeds) {
   cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (regions != nullptr) *regions = 0;
   cv::Mat seen = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   compareWithView(depth_m, cv::Mat(), cv::Rect(0, 0, depth_m.cols, depth_m.rows), T_W_C, K, view,
                   o.check, &seen);
   if (!exclude.empty()) seen.setTo(0, exclude);
-  if (!not_seeds.empty()) seen.setTo(0, not_seeds);
   // Groups are found only where there is anything (most frames see through little or nothing);
   // each group is handled on its own, so the order of their labels does not matter.
-  const cv::Rect bound = cv::boundingRect(seen);
+  cv::Rect bound = cv::boundingRect(seen);
+  if (bound.area() > 0 && not_seeds) {
+    const cv::Mat drop = not_seeds(seen);
+    if (!drop.empty()) seen.setTo(0, drop);
+    bound = cv::boundingRect(seen);
+  }
   if (bound.area() == 0) return out;
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(seen(bound), labels, stats, centroids, 8, CV_32S);

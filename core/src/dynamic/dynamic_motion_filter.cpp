@@ -58,6 +58,11 @@ RigidMotion priorMotion(const MotionFilterInput& input) {
   return prior;
 }
 
+/// `mask` if any of its pixels is set, else an empty Mat (what MotionFilterOutput's masks say).
+cv::Mat anyOrEmpty(const cv::Mat& mask) {
+  return !mask.empty() && cv::countNonZero(mask) > 0 ? mask : cv::Mat();
+}
+
 /// Per match: dynamic (flagged, or on the mask) and held back; the masks of `fused`.
 MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
                                 const std::vector<std::uint8_t>& flagged,
@@ -75,12 +80,10 @@ MotionFilterOutput filterOutput(const std::vector<cv::Point2f>& cur_px,
     out.match_held[i] = !flagged[i] && inMask(fused.unconfirmed, cur_px[i]) ? 1 : 0;
   }
   out.unconfirmed_mask = fused.unconfirmed;
-  if (!fused.held.empty() && cv::countNonZero(fused.held) > 0) out.held_mask = fused.held;
-  if (!fused.confirmed.empty() && cv::countNonZero(fused.confirmed) > 0)
-    out.confirmed_mask = fused.confirmed;
-  if (!fused.moved_objects.empty() && cv::countNonZero(fused.moved_objects) > 0)
-    out.moved_object_mask = fused.moved_objects;
-  if (cv::countNonZero(fused.mask) > 0) out.dynamic_mask = fused.mask;
+  out.held_mask = anyOrEmpty(fused.held);
+  out.confirmed_mask = anyOrEmpty(fused.confirmed);
+  out.moved_object_mask = anyOrEmpty(fused.moved_objects);
+  out.dynamic_mask = anyOrEmpty(fused.mask);
   return out;
 }
 
@@ -278,8 +281,10 @@ void DynamicMotionFilter::addSeenThrough(const cv::Mat& depth_m, const FusionEvi
   if (view == nullptr || depth_m.empty()) return;
   const SeenThroughOptions o = seenThroughOptions(config_);
   // Objects already decided (moving or kept) are fusion's: a kept person is not re-judged here.
-  const cv::Mat still_planes = stillPlaneCells(depth_m, evidence.T_W_C, evidence.K, *view, planes_,
-                                               supportPlaneOptions(config_), o.check);
+  const auto still_planes = [&](const cv::Mat& seeds) {
+    return stillPlaneCells(depth_m, evidence.T_W_C, evidence.K, *view, planes_,
+                           supportPlaneOptions(config_), o.check, seeds);
+  };
   cv::Mat moved =
       seenThroughRegions(depth_m, evidence.T_W_C, evidence.K, *view,
                          fused.mask | fused.static_objects, o, &fused.seen_through, still_planes);

@@ -143,36 +143,33 @@ cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vecto
 
 cv::Mat stillPlaneCells(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                         const DepthView& view, const std::vector<Plane>& planes,
-                        const SupportPlaneOptions& plane_options, const DepthCheckOptions& check) {
+                        const SupportPlaneOptions& plane_options, const DepthCheckOptions& check,
+                        const cv::Mat& candidates) {
   cv::Mat out = cv::Mat::zeros(depth_m.size(), CV_8UC1);
   if (planes.empty() || view.depth_m.empty() || depth_m.empty()) return out;
   const cv::Matx44d T_V_C = view.T_W_C.inv(cv::DECOMP_SVD) * T_W_C;
   const cv::Matx44d T_C_V = T_V_C.inv(cv::DECOMP_SVD);
-  const double sv = view.scale, k_sigma = check.noise_sigmas * std::sqrt(2.0);
+  const double sv = view.scale;
   const int step = std::max(1, check.stride_px), b = std::max(0, check.border_px);
   const cv::Rect image(0, 0, depth_m.cols, depth_m.rows);
   for (int y = b + step / 2; y < depth_m.rows - b; y += step) {
     for (int x = b + step / 2; x < depth_m.cols - b; x += step) {
       const float z = depth_m.at<float>(y, x);
-      if (z <= 0.f) continue;
+      if (z <= 0.f || (!candidates.empty() && candidates.at<uchar>(y, x) == 0)) continue;
       const Sample s = sample(x, y, z, K, plane_options);
       const auto own = std::find_if(planes.begin(), planes.end(),
                                     [&](const Plane& plane) { return onPlane(s, plane); });
       if (own == planes.end()) continue;
-      const cv::Vec4d p_V = T_V_C * cv::Vec4d(s.p[0], s.p[1], s.p[2], 1.0);
-      if (p_V[2] <= 0.1) continue;
-      const int u = cvRound(sv * (K[0] * p_V[0] / p_V[2] + K[2] + 0.5) - 0.5);
-      const int v = cvRound(sv * (K[1] * p_V[1] / p_V[2] + K[3] + 0.5) - 0.5);
-      if (u < 0 || v < 0 || u >= view.depth_m.cols || v >= view.depth_m.rows) continue;
+      int u = 0, v = 0;
+      if (!viewPixel(T_V_C * cv::Vec4d(s.p[0], s.p[1], s.p[2], 1.0), K, view, &u, &v)) continue;
       const double zv = view.depth_m.at<float>(v, u);
       if (zv <= 0.0) continue;
       const double xv = (u + 0.5) / sv - 0.5, yv = (v + 0.5) / sv - 0.5;  // full-image pixel
       const cv::Vec4d q_C =
           T_C_V * cv::Vec4d((xv - K[2]) / K[0] * zv, (yv - K[3]) / K[1] * zv, zv, 1.0);
       const double off = std::abs(own->n.dot(cv::Vec3d(q_C[0], q_C[1], q_C[2])) + own->d);
-      const double margin =
-          k_sigma * depthNoiseM(zv) + check.pose_margin_m + check.relative_margin * zv;
-      if (off <= margin) out(cv::Rect(x - step / 2, y - step / 2, step, step) & image).setTo(255);
+      if (off <= agreementMarginM(zv, check))
+        out(cv::Rect(x - step / 2, y - step / 2, step, step) & image).setTo(255);
     }
   }
   return out;

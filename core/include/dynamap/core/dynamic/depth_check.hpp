@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 
 #include <opencv2/core.hpp>
 
@@ -44,6 +45,15 @@ struct DepthCheckOptions {
 /// One standard deviation (m) of a structured-light depth sensor at depth z (m):
 /// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi, Lovell 2012, for the Kinect).
 inline double depthNoiseM(double z_m) { return 0.0012 + 0.0019 * (z_m - 0.4) * (z_m - 0.4); }
+
+/// How far (m) a view's depth may lie from a point's depth z_m (m) along the same ray and still
+/// be the same surface: the noise of two depths, the pose margin and the share of the depth.
+double agreementMarginM(double z_m, const DepthCheckOptions& options);
+
+/// The pixel (u, v) of `view` where p_V (a point in the view's camera frame, homogeneous) lands,
+/// with the full image's intrinsics K = fx, fy, cx, cy; false if it is behind the view (within
+/// 0.1 m) or outside its depth image.
+bool viewPixel(const cv::Vec4d& p_V, const cv::Vec4d& K, const DepthView& view, int* u, int* v);
 
 /// Depth at (x, y) unless it has none or a 4-neighbour 4 px away is outside the image, has no
 /// depth or differs by more than 0.1 m (a depth edge); else 0. A point on an occlusion edge
@@ -92,11 +102,14 @@ cv::Mat depthSteps(const cv::Mat& depth_m, double step_m);
 /// `exclude`). A surface that only appeared from behind something (the
 /// camera moved) is not seen through: `view` saw the occluder in front of it. CV_8UC1, 255 =
 /// moved; *regions = the number of groups kept.
-/// `not_seeds` (CV_8UC1, may be empty): pixels that start no group but may be grown into.
+/// `not_seeds` (may be empty): given the seen-through pixels outside `exclude` (CV_8UC1, only
+/// called when there are any), returns those that start no group but may be grown into (or an
+/// empty Mat).
+using SeedFilter = std::function<cv::Mat(const cv::Mat& seeds)>;
 cv::Mat seenThroughRegions(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                            const DepthView& view, const cv::Mat& exclude,
                            const SeenThroughOptions& options, int* regions = nullptr,
-                           const cv::Mat& not_seeds = cv::Mat());
+                           const SeedFilter& not_seeds = {});
 
 /// The depth of the last frames with their poses, kept at half resolution, to compare the
 /// current frame with an earlier one. Not thread-safe (one caller).

@@ -49,8 +49,10 @@ cv::Mat planePixels(const cv::Mat& depth_m, const cv::Vec4d& K, const std::vecto
 /// another place can look seen through along the rays (a small pose error moves the depth there
 /// a lot) while every point the view saw still lies on it; a panel slid along a wall is seen
 /// through at its leading edge, where the view saw the wall, far off the panel's plane.
+/// `candidates` (CV_8UC1, may be empty = all): only the samples there are judged.
 cv::Mat stillPlaneCells(const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
                         const DepthView& view, const std::vector<Plane>& planes,
-                        const SupportPlaneOptions& plane_options, const DepthCheckOptions& check);
+                        const SupportPlaneOptions& plane_options, const DepthCheckOptions& check,
+                        const cv::Mat& candidates = cv::Mat());
 
 }  // namespace dynamap
