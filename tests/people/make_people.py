@@ -20,6 +20,8 @@ SCENES = {  # name: (shared scenario, seed)
     'gen_walking_s7': ('dev_walking', 7008),
     'gen_crowd_s9': ('dev_crowd', 7009),
     'gen_walking_s9': ('dev_walking', 7010),
+    'gen_crowd_s11': ('dev_crowd', 7011),
+    'gen_crowd_s13': ('dev_crowd', 7013),
 }
 
 
