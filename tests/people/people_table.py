@@ -5,15 +5,17 @@ the shared ones"): the two shared sequences and the scenes make_people.py made.
 usage: people_table.py --dynamap BIN --scenes DIR [--out DIR] [--jobs N] [--set KEY=VALUE ...]
 
 BIN runs with its own libraries (BIN/../lib, as a frozen copy of a build does). Runs go to
---out (default /tmp/people_runs/<label>); a run folder that holds metrics.json is read, not run
+--out (default /tmp/people_runs/default); a run folder that holds metrics.json is read, not run
 again. Prints one Markdown row per scene.
 """
-import argparse, json, os, subprocess, sys
+import argparse, json, os, sys
 from concurrent.futures import ThreadPoolExecutor
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, '..', 'real_data'))
 from make_people import SCENES, SHARED  # noqa: E402
+from bands import run_dynamap  # noqa: E402
 
 SHARED_SCENES = ('teddy_dyn_dev', 'teddy_dyn_crowd_dev')
 
@@ -25,17 +27,8 @@ def sequence(name, scenes_dir):
 
 
 def run(binary, seq, out, overrides):
-    if os.path.isfile(os.path.join(out, 'metrics.json')):
-        return
-    cmd = [binary, 'run', '--sequence', seq, '--out', out, '--quiet', '--save-masks']
-    for kv in overrides:
-        cmd += ['--set', kv]
-    env = dict(os.environ)
-    lib = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(binary))), 'lib')
-    env['LD_LIBRARY_PATH'] = lib + (':' + env['LD_LIBRARY_PATH'] if env.get('LD_LIBRARY_PATH') else '')
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
-    if proc.returncode != 0:
-        raise RuntimeError('%s failed (exit %d):\n%s' % (' '.join(cmd), proc.returncode, proc.stdout))
+    if not os.path.isfile(os.path.join(out, 'metrics.json')):
+        run_dynamap(binary, seq, out, overrides, extra=['--save-masks'])
 
 
 def share(x):

@@ -119,11 +119,20 @@ def prepare(case, start, work):
 
 def run(dynamap, case, seq, out, overrides=()):
     shutil.rmtree(out, ignore_errors=True)
+    config = os.path.join(SOURCE, CASES[case][2]) if CASES[case][2] else None
+    run_dynamap(dynamap, seq, out, overrides, config)
+    return read_metrics(out)
+
+
+def run_dynamap(dynamap, seq, out, overrides=(), config=None, extra=()):
+    """`dynamap run` of `seq` into `out` (`--set` each override, `--config` if given, then
+    `extra` arguments); raises RuntimeError with its output if it fails."""
     cmd = [dynamap, "run", "--sequence", seq, "--out", out, "--quiet"]
     for override in overrides:
         cmd += ["--set", override]
-    if CASES[case][2]:
-        cmd += ["--config", os.path.join(SOURCE, CASES[case][2])]
+    if config:
+        cmd += ["--config", config]
+    cmd += list(extra)
     # A build's (or a frozen copy's) own libraries and plugins: <dir>/bin/dynamap, <dir>/lib.
     env = dict(os.environ)
     lib = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(dynamap))), "lib")
@@ -132,7 +141,6 @@ def run(dynamap, case, seq, out, overrides=()):
     if proc.returncode != 0:
         raise RuntimeError("real_data: %s failed (exit %d):\n%s" % (" ".join(cmd),
                                                                     proc.returncode, proc.stdout))
-    return read_metrics(out)
 
 
 def read_metrics(out):
