@@ -72,7 +72,9 @@ TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 12);
   scene.addDefaultRoom();
-  Tracker tracker(camera, TrackerConfig{}, nullptr);
+  TrackerConfig config;
+  config.depth_fallback = false;  // no pose from the depth either (the next test has it)
+  Tracker tracker(camera, config, nullptr);
   constexpr int kBlankFirst = 25, kBlankLast = 28;
   for (int i = 0; i < 45; ++i) {
     auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
@@ -101,6 +103,38 @@ TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
   EXPECT_EQ(s.lost, static_cast<std::size_t>(kBlankLast - kBlankFirst + 1));
   EXPECT_EQ(s.relocalized, 1u);
   EXPECT_EQ(s.tracked + s.relocalized + s.lost + s.bad_frames, s.frames);
+}
+
+// Colour frames without texture (black) but with depth, as where people fill the view: the
+// depth of the static pixels poses them (tracking.depth_fallback), none is lost, and the
+// features come back by relocalization. Tolerance: 1 cm, a third of the 4 frames' motion.
+TEST(SyntheticTracking, BlankFramesWithDepthArePosedByTheDepthAlone) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 12);
+  scene.addDefaultRoom();
+  Tracker tracker(camera, TrackerConfig{}, nullptr);
+  constexpr int kBlankFirst = 25, kBlankLast = 28;
+  for (int i = 0; i < 45; ++i) {
+    auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
+    if (i >= kBlankFirst && i <= kBlankLast) r.bgr.setTo(cv::Scalar::all(0));
+    const TrackingResult res = tracker.track(makeFrame(r, i));
+    if (i >= kBlankFirst && i <= kBlankLast) {
+      EXPECT_EQ(res.status, FrameStatus::kTracked) << "frame " << i;
+      EXPECT_FALSE(res.is_keyframe) << "frame " << i;
+    }
+  }
+  tracker.finish();
+  const auto traj = tracker.finalTrajectory();
+  ASSERT_EQ(traj.size(), 45u);
+  const double moved = (test::smoothPath(kBlankFirst - 1, kFrames).translation() -
+                        test::smoothPath(kBlankLast, kFrames).translation()).norm();
+  ASSERT_GT(moved, 0.03);
+  for (int i = kBlankFirst; i < 45; ++i) {
+    EXPECT_LT(translationError(traj[static_cast<std::size_t>(i)].second, i), 0.01) << i;
+  }
+  const TrackerStats s = tracker.stats();
+  EXPECT_EQ(s.lost, 0u);
+  EXPECT_LE(s.relocalized, 1u);
 }
 
 TEST(SyntheticTracking, BlankFramesWithoutDepthAreLostAndTrackingResumes) {

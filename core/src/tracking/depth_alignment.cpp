@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
+#include <opencv2/rgbd.hpp>
 
 #include "dynamap/core/rounding.hpp"
 
@@ -98,12 +100,32 @@ Linearisation linearise(const PosedDepth& ref, const std::vector<Eigen::Vector3d
   return lin;
 }
 
-Eigen::Isometry3d twistToPose(const Vector6d& xi) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d w = xi.tail<3>();
-  if (w.norm() > 0.0) T.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
-  T.translation() = xi.head<3>();
-  return T;
+/// A depth image for OpenCV's odometry: no reading (0) becomes NaN, which it leaves out.
+cv::Mat odometryDepth(const cv::Mat& depth_m) {
+  cv::Mat d = depth_m.clone();
+  d.setTo(std::numeric_limits<float>::quiet_NaN(), d <= 0.f);
+  return d;
+}
+
+/// OpenCV's mask: nonzero = take part (ours: nonzero = left out).
+cv::Mat odometryMask(const cv::Mat& moving_mask, const cv::Size& size) {
+  return moving_mask.empty() ? cv::Mat(size, CV_8UC1, cv::Scalar(255)) : cv::Mat(moving_mask == 0);
+}
+
+cv::Mat toCv(const Eigen::Isometry3d& T) {
+  cv::Mat m(4, 4, CV_64F);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) m.at<double>(r, c) = T.matrix()(r, c);
+  }
+  return m;
+}
+
+Eigen::Isometry3d fromCv(const cv::Mat& m) {
+  Eigen::Matrix4d e;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) e(r, c) = m.at<double>(r, c);
+  }
+  return Eigen::Isometry3d(e);
 }
 
 /// The smallest eigenvalue of the translation block of the normal equations.
@@ -128,6 +150,23 @@ void scoreResult(const Linearisation& lin, const DepthAlignmentOptions& o, Depth
                  out.weakest_direction_points >= o.min_weakest_direction_points;
 }
 
+/// OpenCV's point-to-plane ICP from `T_C_R_guess` (T_C_R maps the reference's points into the
+/// current frame), associations up to `max_difference_m` apart; empty if it fails.
+cv::Mat icpStep(const cv::Mat& K, const PosedDepth& reference, const PosedDepth& current,
+                const DepthAlignmentOptions& o, double max_difference_m, const cv::Mat& T_C_R_guess) {
+  cv::rgbd::ICPOdometry icp(K, static_cast<float>(o.min_depth_m), static_cast<float>(o.max_depth_m),
+                            static_cast<float>(max_difference_m));
+  icp.setMaxTranslation(o.max_translation_m);
+  icp.setMaxRotation(o.max_rotation_deg);
+  cv::Mat T_C_R;
+  const bool solved = icp.compute(cv::Mat(), odometryDepth(reference.depth_m),
+                                  odometryMask(reference.moving_mask, reference.depth_m.size()),
+                                  cv::Mat(), odometryDepth(current.depth_m),
+                                  odometryMask(current.moving_mask, current.depth_m.size()), T_C_R,
+                                  T_C_R_guess);
+  return solved ? T_C_R : cv::Mat();
+}
+
 }  // namespace
 
 DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current,
@@ -135,24 +174,17 @@ DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current
   DepthAlignment out;
   out.T_W_C = current.T_W_C;
   if (reference.depth_m.type() != CV_32FC1 || current.depth_m.type() != CV_32FC1) return out;
-  const std::vector<Eigen::Vector3d> points = currentPoints(current, camera, o);
-  Eigen::Isometry3d T_R_C = reference.T_W_C.inverse() * current.T_W_C;
-  const int iterations = std::max(1, o.max_iterations);
-  for (int it = 0; it < iterations; ++it) {
-    const double a = iterations > 1 ? static_cast<double>(it) / (iterations - 1) : 1.0;
-    const double gate = o.start_gate_m * std::pow(o.end_gate_m / o.start_gate_m, a);
-    const Linearisation lin = linearise(reference, points, T_R_C, camera, o, gate);
-    if (lin.residuals.size() < 6) return out;
-    const Vector6d xi = lin.H.ldlt().solve(-lin.b);
-    if (!xi.allFinite()) return out;
-    T_R_C = twistToPose(xi) * T_R_C;
-    if (xi.head<3>().norm() < 1e-5 && xi.tail<3>().norm() < 1e-5 && gate <= o.end_gate_m * 1.5) {
-      break;
-    }
-  }
-  const Linearisation last = linearise(reference, points, T_R_C, camera, o, o.end_gate_m);
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy,
+                     0, 0, 1);
+  // Coarse (far associations, to reach the minimum from the guess), then fine (near ones only).
+  const cv::Mat coarse = icpStep(K, reference, current, o, o.coarse_depth_difference_m,
+                                 toCv(current.T_W_C.inverse() * reference.T_W_C));
+  if (coarse.empty()) return out;
+  const cv::Mat fine = icpStep(K, reference, current, o, o.fine_depth_difference_m, coarse);
+  const Eigen::Isometry3d T_R_C = fromCv(fine.empty() ? coarse : fine).inverse();
   out.T_W_C = reference.T_W_C * T_R_C;
-  scoreResult(last, o, out);
+  scoreResult(linearise(reference, currentPoints(current, camera, o), T_R_C, camera, o, o.end_gate_m),
+              o, out);
   return out;
 }
 

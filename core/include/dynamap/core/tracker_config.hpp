@@ -208,9 +208,9 @@ struct TrackerConfig {
   int restart_after_lost_frames = 5;
   /// Where neither the features nor relocalization give the pose (a view filled by people),
   /// the depth of the frame's static pixels is aligned to the last tracked frame's
-  /// (depth_alignment.hpp); such frames make no keyframe and count as lost for the restart.
-  /// Off: on the Bonn slice it removes every lost frame but raises the ATE (BENCHMARKS.md).
-  bool depth_fallback = false;
+  /// (depth_alignment.hpp: OpenCV's ICP odometry); such frames make no keyframe and count as
+  /// lost for the restart. On the Bonn slice it poses every frame that was lost (BENCHMARKS.md).
+  bool depth_fallback = true;
 
   // --- loop closure (own thread; core/include/dynamap/core/tracking/loop_closer.hpp) ---
   /// Each keyframe's static ORB features (outside the widened motion mask and the held pixels,

@@ -17,12 +17,17 @@ struct PosedDepth {
 };
 
 struct DepthAlignmentOptions {
-  int pixel_stride = 4;          ///< every n-th pixel of every n-th row of the current image
-  int max_iterations = 20;
   double min_depth_m = 0.3;
   double max_depth_m = 4.0;
-  double start_gate_m = 0.15;    ///< association distance at the first iteration,
-  double end_gate_m = 0.03;      ///< shrinking to this one
+  /// OpenCV's ICP runs twice: associations up to this far apart (reaching the minimum from the
+  /// guess), then from its result ...
+  double coarse_depth_difference_m = 0.3;
+  double fine_depth_difference_m = 0.07;  ///< ... up to this far (robust to what it left out)
+  double max_translation_m = 0.15;       ///< OpenCV's ICP fails beyond this step
+  double max_rotation_deg = 15.0;        ///< ... or this one
+  // The score of the result (accepted or not):
+  int pixel_stride = 4;          ///< every n-th pixel of every n-th row of the current image
+  double end_gate_m = 0.03;      ///< association distance
   double huber_m = 0.01;         ///< residuals beyond weigh less
   double inlier_m = 0.015;       ///< |point-to-plane residual| of an inlier at the end
   int min_inliers = 1500;        ///< fewer: not accepted
@@ -44,11 +49,12 @@ struct DepthAlignment {
   bool accepted = false;
 };
 
-/// Point-to-plane ICP of `current`'s static pixels against `reference`'s static surface, with
-/// projective association (each current point meets the reference pixel it projects to, whose
-/// normal comes from its neighbours), Huber-weighted Gauss-Newton on SE(3), starting at
-/// `current.T_W_C`. The dense term where features are few (a view filled by people): it needs
-/// only depth, and rejects alignments the geometry does not pin down.
+/// `current`'s static pixels aligned to `reference`'s static surface by OpenCV's point-to-plane
+/// ICP odometry (cv::rgbd::ICPOdometry, a depth pyramid), starting at `current.T_W_C`; the
+/// result is then scored with projective association (each current point meets the reference
+/// pixel it projects to, whose normal comes from its neighbours). The dense term where features
+/// are few (a view filled by people): it needs only depth, and rejects alignments the geometry
+/// does not pin down.
 DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current,
                           const PinholeCamera& camera, const DepthAlignmentOptions& options = {});
 
