@@ -10,6 +10,8 @@ const char* toString(FrameStatus status) {
       return "relocalized";
     case FrameStatus::kLost:
       return "lost";
+    case FrameStatus::kPosedByDepth:
+      return "depth";
     case FrameStatus::kBadFrame:
       return "bad_frame";
   }

@@ -94,7 +94,7 @@ void System::Impl::pushKeyframe(KeyframePacketPtr kf) {
 void System::Impl::lookAhead(const RgbdFrame& frame, const TrackingResult& tracked,
                              std::vector<KeyframePacketPtr>& mapped) {
   if (!pending) return;
-  if (tracked.status == FrameStatus::kTracked || tracked.status == FrameStatus::kRelocalized) {
+  if (tracked.status != FrameStatus::kLost && tracked.status != FrameStatus::kBadFrame) {
     ScopedStageTimer timer(timings, "mask_lookahead");
     // Only what the later frame saw moving: a person masked there for lack of evidence that
     // they stand still (held back) is no evidence against the keyframe's pixels.
@@ -290,6 +290,7 @@ SystemCounts System::counts() const {
     const TrackerStats stats = s.tracker->stats();
     c.tracked = stats.tracked;
     c.relocalized = stats.relocalized;
+    c.posed_by_depth = stats.posed_by_depth;
     c.lost = stats.lost;
     c.keyframes = stats.keyframes - stats.culled_keyframes;
     c.culled_keyframes = stats.culled_keyframes;

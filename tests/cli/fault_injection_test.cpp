@@ -153,7 +153,8 @@ TEST(FaultInjection, AllZeroDepthFramesAreTrackedAndCounted) {
   EXPECT_EQ(stringMember(run, "status").value_or(""), "complete");
   EXPECT_EQ(count(run, "frames_read"), static_cast<double>(kFrames));
   EXPECT_EQ(count(run, "bad_frames"), 0.0);  // no depth is a valid frame, not a bad one
-  EXPECT_LE(count(run, "tracked") + count(run, "relocalized") + count(run, "lost"),
+  EXPECT_LE(count(run, "tracked") + count(run, "posed_by_depth") + count(run, "relocalized") +
+                count(run, "lost"),
             count(run, "frames_read"));
   const std::size_t poses = test::countDataLines((out / "trajectory.txt").string());
   EXPECT_GE(poses, 20u);
@@ -183,7 +184,8 @@ TEST(FaultInjection, LongTrackingLossRelocalizesOrReportsLost) {
   EXPECT_EQ(count(run, "frames_read"), static_cast<double>(kFrames));
   EXPECT_EQ(count(run, "bad_frames"), 0.0);
   EXPECT_GE(count(run, "lost"), 1.0) << "black frames cannot be tracked";
-  EXPECT_LE(count(run, "tracked") + count(run, "relocalized") + count(run, "lost"),
+  EXPECT_LE(count(run, "tracked") + count(run, "posed_by_depth") + count(run, "relocalized") +
+                count(run, "lost"),
             count(run, "frames_read"));
   // The frames before the blackout keep their poses.
   EXPECT_GE(test::countDataLines((out / "trajectory.txt").string()), 15u);

@@ -337,6 +337,7 @@ void Pipeline::finalize(RunResult& result) {
   const SystemCounts counts = system.counts();
   result.counts.tracked = counts.tracked;
   result.counts.relocalized = counts.relocalized;
+  result.counts.posed_by_depth = counts.posed_by_depth;
   result.counts.lost = counts.lost;
   result.counts.keyframes = counts.keyframes;
   result.counts.culled_keyframes = counts.culled_keyframes;

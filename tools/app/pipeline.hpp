@@ -25,6 +25,7 @@ struct RunCounts {
   std::size_t frames_read = 0;
   std::size_t tracked = 0;
   std::size_t relocalized = 0;
+  std::size_t posed_by_depth = 0;
   std::size_t lost = 0;
   std::size_t bad_frames = 0;
   std::size_t keyframes = 0;         ///< kept (SystemCounts::keyframes)

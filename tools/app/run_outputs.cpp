@@ -71,6 +71,7 @@ void writeRunJson(const std::string& out_dir, const RunResult& result) {
   Json counts = {{"frames_read", c.frames_read},
                  {"tracked", c.tracked},
                  {"relocalized", c.relocalized},
+                 {"posed_by_depth", c.posed_by_depth},
                  {"lost", c.lost},
                  {"bad_frames", c.bad_frames},
                  {"keyframes", c.keyframes},
@@ -156,7 +157,8 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
                      const RunReport& report) {
   const RunCounts& c = result.counts;
   out << "run " << result.status << ": " << c.frames_read << " frames read, " << c.tracked
-      << " tracked, " << c.relocalized << " relocalized, " << c.lost << " lost, " << c.bad_frames
+      << " tracked, " << c.posed_by_depth << " posed by depth, " << c.relocalized << " relocalized, "
+      << c.lost << " lost, " << c.bad_frames
       << " bad; " << c.keyframes << " keyframes (" << c.culled_keyframes << " more culled); "
       << report.frames_per_s << " frames/s (" << result.finish_s << " s of it finishing)\n";
   if (!result.error.empty()) out << "error: " << result.error << "\n";

@@ -135,7 +135,7 @@ FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray
     return FrameStatus::kRelocalized;
   }
   posed_by_depth_ = alignToLastDepth(frame, widened.dynamic_mask, T_W_C);
-  return posed_by_depth_ ? FrameStatus::kTracked : FrameStatus::kLost;
+  return posed_by_depth_ ? FrameStatus::kPosedByDepth : FrameStatus::kLost;
 }
 
 // The dense fallback: the static depth aligned to the last tracked frame's, from the predicted

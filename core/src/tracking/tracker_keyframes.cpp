@@ -259,6 +259,7 @@ void Tracker::Impl::countStatus(FrameStatus status, bool keyframe) {
   ++stats_.frames;
   if (status == FrameStatus::kTracked) ++stats_.tracked;
   if (status == FrameStatus::kRelocalized) ++stats_.relocalized;
+  if (status == FrameStatus::kPosedByDepth) ++stats_.posed_by_depth;
   if (status == FrameStatus::kLost) ++stats_.lost;
   if (keyframe) ++stats_.keyframes;
 }

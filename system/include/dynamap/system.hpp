@@ -36,6 +36,7 @@ struct TrackOutput {
 struct SystemCounts {
   std::size_t frames = 0;  ///< frames given to track() / mapWithPose() / markBadFrame()
   std::size_t tracked = 0, relocalized = 0, lost = 0, bad_frames = 0;
+  std::size_t posed_by_depth = 0;  ///< frames posed by their static depth alone (status "depth")
   std::size_t keyframes = 0;  ///< made and kept (not culled)
   /// Made, then culled as redundant (tracking.kf_cull_redundant): not in keyframes() or a saved
   /// map; their views stay in the dense map (mapped_keyframes counts them).

@@ -22,6 +22,7 @@ enum class FrameStatus : std::uint8_t {
   kTracked,      ///< pose estimated from tracked features
   kRelocalized,  ///< pose recovered by relocalization after a loss
   kLost,         ///< no pose could be estimated; the pose is the last known one
+  kPosedByDepth, ///< posed by the static depth alone (tracking.depth_fallback): no features held it
   kBadFrame,     ///< frame could not be read/decoded; skipped
 };
 

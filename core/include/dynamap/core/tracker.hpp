@@ -35,9 +35,10 @@ struct TrackingResult {
   cv::Mat held_mask;
 };
 
-/// Counters over all frames. frames = tracked + relocalized + lost + bad_frames.
+/// Counters over all frames. frames = tracked + posed_by_depth + relocalized + lost + bad_frames.
 struct TrackerStats {
   std::size_t frames = 0, tracked = 0, relocalized = 0, lost = 0, keyframes = 0;
+  std::size_t posed_by_depth = 0;  ///< FrameStatus::kPosedByDepth
   /// Of `keyframes`, culled later (TrackerConfig::kf_cull_redundant).
   std::size_t culled_keyframes = 0;
   std::size_t bad_frames = 0;
