@@ -68,73 +68,84 @@ TEST(SyntheticTracking, SmoothSixDofSequenceHasSubCentimetreAte) {
   EXPECT_LT(timings.stats("orb").count, static_cast<std::size_t>(kFrames));  // not every frame
 }
 
-TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
+constexpr int kBlackFirst = 25, kBlackLast = 28, kBlankRunFrames = 45;
+
+/// The room's 45 frames, frames kBlackFirst..kBlackLast with black colour images (depth kept):
+/// the live statuses and keyframe flags of those frames, then the tracker's outputs.
+struct BlankColourRun {
+  std::vector<FrameStatus> blank_status;
+  std::vector<bool> blank_keyframe;
+  std::vector<FrameStatus> statuses;
+  std::vector<std::pair<double, Eigen::Isometry3d>> trajectory;
+  TrackerStats stats;
+};
+
+/// `bad_frame_after` >= 0: a bad frame is marked after that frame.
+BlankColourRun trackBlankColour(const TrackerConfig& config, int bad_frame_after) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 12);
   scene.addDefaultRoom();
-  TrackerConfig config;
-  config.depth_fallback = false;  // no pose from the depth either (the next test has it)
   Tracker tracker(camera, config, nullptr);
-  constexpr int kBlankFirst = 25, kBlankLast = 28;
-  for (int i = 0; i < 45; ++i) {
+  BlankColourRun run;
+  for (int i = 0; i < kBlankRunFrames; ++i) {
     auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
-    // Black colour images with depth: tracking is lost and must relocalize afterwards.
-    if (i >= kBlankFirst && i <= kBlankLast) r.bgr.setTo(cv::Scalar::all(0));
+    const bool blank = i >= kBlackFirst && i <= kBlackLast;
+    if (blank) r.bgr.setTo(cv::Scalar::all(0));
     const TrackingResult res = tracker.track(makeFrame(r, i));
-    if (i >= kBlankFirst && i <= kBlankLast) {
-      EXPECT_EQ(res.status, FrameStatus::kLost) << "frame " << i;
+    if (blank) {
+      run.blank_status.push_back(res.status);
+      run.blank_keyframe.push_back(res.is_keyframe);
     }
-    if (i == 30) tracker.markBadFrame(i * kFramePeriodS + 0.01);
+    if (i == bad_frame_after) tracker.markBadFrame(i * kFramePeriodS + 0.01);
   }
   tracker.finish();
-  const auto statuses = tracker.frameStatuses();
-  const auto traj = tracker.finalTrajectory();
-  ASSERT_EQ(statuses.size(), 45u);
-  EXPECT_EQ(statuses[kBlankLast + 1], FrameStatus::kRelocalized);
-  for (int i = kBlankLast + 2; i < 45; ++i) {
-    EXPECT_EQ(statuses[static_cast<std::size_t>(i)], FrameStatus::kTracked) << "frame " << i;
+  run.statuses = tracker.frameStatuses();
+  run.trajectory = tracker.finalTrajectory();
+  run.stats = tracker.stats();
+  return run;
+}
+
+// Black colour images with depth and the depth fallback off: tracking is lost and must
+// relocalize afterwards.
+TEST(SyntheticTracking, BlankFramesAreLostThenRelocalized) {
+  TrackerConfig config;
+  config.depth_fallback = false;
+  const BlankColourRun run = trackBlankColour(config, 30);
+  for (const FrameStatus status : run.blank_status) EXPECT_EQ(status, FrameStatus::kLost);
+  ASSERT_EQ(run.statuses.size(), 45u);
+  EXPECT_EQ(run.statuses[kBlackLast + 1], FrameStatus::kRelocalized);
+  for (int i = kBlackLast + 2; i < kBlankRunFrames; ++i) {
+    EXPECT_EQ(run.statuses[static_cast<std::size_t>(i)], FrameStatus::kTracked) << "frame " << i;
   }
-  for (int i = kBlankLast + 1; i < 45; ++i) {
-    EXPECT_LT(translationError(traj[static_cast<std::size_t>(i)].second, i), 0.02) << i;
+  for (int i = kBlackLast + 1; i < kBlankRunFrames; ++i) {
+    EXPECT_LT(translationError(run.trajectory[static_cast<std::size_t>(i)].second, i), 0.02) << i;
   }
-  const TrackerStats s = tracker.stats();
+  const TrackerStats& s = run.stats;
   EXPECT_EQ(s.frames, 46u);
   EXPECT_EQ(s.bad_frames, 1u);
-  EXPECT_EQ(s.lost, static_cast<std::size_t>(kBlankLast - kBlankFirst + 1));
+  EXPECT_EQ(s.lost, static_cast<std::size_t>(kBlackLast - kBlackFirst + 1));
   EXPECT_EQ(s.relocalized, 1u);
   EXPECT_EQ(s.tracked + s.relocalized + s.lost + s.bad_frames, s.frames);
 }
 
-// Colour frames without texture (black) but with depth, as where people fill the view: the
-// depth of the static pixels poses them (tracking.depth_fallback), none is lost, and the
-// features come back by relocalization. Tolerance: 1 cm, a third of the 4 frames' motion.
+// The same frames with the depth fallback (the default), as where people fill the view: the
+// depth of the static pixels poses them, none is lost and none makes a keyframe; the features
+// come back by relocalization. Tolerance: 1 cm, a third of the 4 frames' motion.
 TEST(SyntheticTracking, BlankFramesWithDepthArePosedByTheDepthAlone) {
-  const PinholeCamera camera = cameraPreset("freiburg3");
-  test::SyntheticScene scene(camera, 12);
-  scene.addDefaultRoom();
-  Tracker tracker(camera, TrackerConfig{}, nullptr);
-  constexpr int kBlankFirst = 25, kBlankLast = 28;
-  for (int i = 0; i < 45; ++i) {
-    auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
-    if (i >= kBlankFirst && i <= kBlankLast) r.bgr.setTo(cv::Scalar::all(0));
-    const TrackingResult res = tracker.track(makeFrame(r, i));
-    if (i >= kBlankFirst && i <= kBlankLast) {
-      EXPECT_EQ(res.status, FrameStatus::kPosedByDepth) << "frame " << i;
-      EXPECT_FALSE(res.is_keyframe) << "frame " << i;
-    }
-  }
-  tracker.finish();
-  const auto traj = tracker.finalTrajectory();
-  ASSERT_EQ(traj.size(), 45u);
-  const double moved = (test::smoothPath(kBlankFirst - 1, kFrames).translation() -
-                        test::smoothPath(kBlankLast, kFrames).translation()).norm();
+  const BlankColourRun run = trackBlankColour(TrackerConfig{}, -1);
+  for (const FrameStatus status : run.blank_status) EXPECT_EQ(status, FrameStatus::kPosedByDepth);
+  for (const bool keyframe : run.blank_keyframe) EXPECT_FALSE(keyframe);
+  ASSERT_EQ(run.trajectory.size(), 45u);
+  const double moved = (test::smoothPath(kBlackFirst - 1, kFrames).translation() -
+                        test::smoothPath(kBlackLast, kFrames).translation())
+                           .norm();
   ASSERT_GT(moved, 0.03);
-  for (int i = kBlankFirst; i < 45; ++i) {
-    EXPECT_LT(translationError(traj[static_cast<std::size_t>(i)].second, i), 0.01) << i;
+  for (int i = kBlackFirst; i < kBlankRunFrames; ++i) {
+    EXPECT_LT(translationError(run.trajectory[static_cast<std::size_t>(i)].second, i), 0.01) << i;
   }
-  const TrackerStats s = tracker.stats();
-  EXPECT_EQ(s.lost, 0u);
-  EXPECT_LE(s.relocalized, 1u);
+  EXPECT_EQ(run.stats.lost, 0u);
+  EXPECT_EQ(run.stats.posed_by_depth, static_cast<std::size_t>(kBlackLast - kBlackFirst + 1));
+  EXPECT_LE(run.stats.relocalized, 1u);
 }
 
 TEST(SyntheticTracking, BlankFramesWithoutDepthAreLostAndTrackingResumes) {

@@ -57,10 +57,10 @@ bool surfaceAt(const PosedDepth& ref, const PinholeCamera& camera, const DepthAl
   for (const double n : {zl, zr, zu, zd}) {
     if (!(n > 0.0) || std::abs(n - z) > step) return false;
   }
-  const Eigen::Vector3d dx = camera.backProject(x + kReach, y, zr) -
-                             camera.backProject(x - kReach, y, zl);
-  const Eigen::Vector3d dy = camera.backProject(x, y + kReach, zd) -
-                             camera.backProject(x, y - kReach, zu);
+  const Eigen::Vector3d dx =
+      camera.backProject(x + kReach, y, zr) - camera.backProject(x - kReach, y, zl);
+  const Eigen::Vector3d dy =
+      camera.backProject(x, y + kReach, zd) - camera.backProject(x, y - kReach, zu);
   const Eigen::Vector3d normal = dx.cross(dy);
   if (normal.norm() < 1e-12) return false;
   out.point = camera.backProject(x, y, z);
@@ -153,17 +153,18 @@ void scoreResult(const Linearisation& lin, const DepthAlignmentOptions& o, Depth
 /// OpenCV's point-to-plane ICP from `T_C_R_guess` (T_C_R maps the reference's points into the
 /// current frame), associations up to `max_difference_m` apart; empty if it fails.
 cv::Mat icpStep(const cv::Mat& K, const PosedDepth& reference, const PosedDepth& current,
-                const DepthAlignmentOptions& o, double max_difference_m, const cv::Mat& T_C_R_guess) {
+                const DepthAlignmentOptions& o, double max_difference_m,
+                const cv::Mat& T_C_R_guess) {
   cv::rgbd::ICPOdometry icp(K, static_cast<float>(o.min_depth_m), static_cast<float>(o.max_depth_m),
                             static_cast<float>(max_difference_m));
   icp.setMaxTranslation(o.max_translation_m);
   icp.setMaxRotation(o.max_rotation_deg);
   cv::Mat T_C_R;
-  const bool solved = icp.compute(cv::Mat(), odometryDepth(reference.depth_m),
-                                  odometryMask(reference.moving_mask, reference.depth_m.size()),
-                                  cv::Mat(), odometryDepth(current.depth_m),
-                                  odometryMask(current.moving_mask, current.depth_m.size()), T_C_R,
-                                  T_C_R_guess);
+  const bool solved =
+      icp.compute(cv::Mat(), odometryDepth(reference.depth_m),
+                  odometryMask(reference.moving_mask, reference.depth_m.size()), cv::Mat(),
+                  odometryDepth(current.depth_m),
+                  odometryMask(current.moving_mask, current.depth_m.size()), T_C_R, T_C_R_guess);
   return solved ? T_C_R : cv::Mat();
 }
 
@@ -174,8 +175,8 @@ DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current
   DepthAlignment out;
   out.T_W_C = current.T_W_C;
   if (reference.depth_m.type() != CV_32FC1 || current.depth_m.type() != CV_32FC1) return out;
-  const cv::Mat K = (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy,
-                     0, 0, 1);
+  const cv::Mat K =
+      (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
   // Coarse (far associations, to reach the minimum from the guess), then fine (near ones only).
   const cv::Mat coarse = icpStep(K, reference, current, o, o.coarse_depth_difference_m,
                                  toCv(current.T_W_C.inverse() * reference.T_W_C));
@@ -183,8 +184,9 @@ DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current
   const cv::Mat fine = icpStep(K, reference, current, o, o.fine_depth_difference_m, coarse);
   const Eigen::Isometry3d T_R_C = fromCv(fine.empty() ? coarse : fine).inverse();
   out.T_W_C = reference.T_W_C * T_R_C;
-  scoreResult(linearise(reference, currentPoints(current, camera, o), T_R_C, camera, o, o.end_gate_m),
-              o, out);
+  scoreResult(
+      linearise(reference, currentPoints(current, camera, o), T_R_C, camera, o, o.end_gate_m), o,
+      out);
   return out;
 }
 
