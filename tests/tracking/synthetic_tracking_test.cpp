@@ -80,8 +80,10 @@ struct BlankColourRun {
   TrackerStats stats;
 };
 
-/// `bad_frame_after` >= 0: a bad frame is marked after that frame.
-BlankColourRun trackBlankColour(const TrackerConfig& config, int bad_frame_after) {
+/// `bad_frame_after` >= 0: a bad frame is marked after that frame. `black_last`: the last black
+/// frame.
+BlankColourRun trackBlankColour(const TrackerConfig& config, int bad_frame_after,
+                                int black_last = kBlackLast) {
   const PinholeCamera camera = cameraPreset("freiburg3");
   test::SyntheticScene scene(camera, 12);
   scene.addDefaultRoom();
@@ -89,7 +91,7 @@ BlankColourRun trackBlankColour(const TrackerConfig& config, int bad_frame_after
   BlankColourRun run;
   for (int i = 0; i < kBlankRunFrames; ++i) {
     auto r = scene.render(test::smoothPath(i, kFrames), i * kFramePeriodS);
-    const bool blank = i >= kBlackFirst && i <= kBlackLast;
+    const bool blank = i >= kBlackFirst && i <= black_last;
     if (blank) r.bgr.setTo(cv::Scalar::all(0));
     const TrackingResult res = tracker.track(makeFrame(r, i));
     if (blank) {
@@ -146,6 +148,19 @@ TEST(SyntheticTracking, BlankFramesWithDepthArePosedByTheDepthAlone) {
   EXPECT_EQ(run.stats.lost, 0u);
   EXPECT_EQ(run.stats.posed_by_depth, static_cast<std::size_t>(kBlackLast - kBlackFirst + 1));
   EXPECT_LE(run.stats.relocalized, 1u);
+}
+
+// Black for longer than tracking.restart_after_lost_frames (5): five frames are posed by depth,
+// the map restarts, and the first frame with colour again starts it; the frames after it track
+// its new features (a stale "posed by depth" once dropped them, and they were posed by depth).
+TEST(SyntheticTracking, AMapRestartedAfterDepthPosedFramesKeepsItsNewTracks) {
+  const int black_last = kBlackFirst + 11;
+  const BlankColourRun run = trackBlankColour(TrackerConfig{}, -1, black_last);
+  EXPECT_EQ(run.stats.posed_by_depth, 5u);
+  ASSERT_EQ(run.statuses.size(), static_cast<std::size_t>(kBlankRunFrames));
+  for (int i = black_last + 1; i < kBlankRunFrames; ++i) {
+    EXPECT_EQ(run.statuses[static_cast<std::size_t>(i)], FrameStatus::kTracked) << "frame " << i;
+  }
 }
 
 TEST(SyntheticTracking, BlankFramesWithoutDepthAreLostAndTrackingResumes) {

@@ -70,7 +70,8 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
       // from depth alone bridges the frame: its features (few, near the movers) make no keyframe.
       // A keyframe that is due where one already covers the view is not made (a revisit).
       const cv::Mat movers = certainMask(filtered);
-      if (!posed_by_depth_ && needKeyframe(frame.timestamp_s, T_W_C, movers) &&
+      if (result.status != FrameStatus::kPosedByDepth &&
+          needKeyframe(frame.timestamp_s, T_W_C, movers) &&
           !reuseKeyframe(frame, gray, widened.dynamic_mask, movers, T_W_C, result.inliers)) {
         result.keyframe = createKeyframe(frame, gray, T_W_C, filtered, widened.dynamic_mask);
       }
@@ -126,7 +127,6 @@ void Tracker::Impl::startMap(const RgbdFrame& frame, const cv::Mat& gray,
 FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray,
                                      const MotionFilterOutput& widened, Eigen::Isometry3d& T_W_C,
                                      int& inliers) {
-  posed_by_depth_ = false;
   if (estimatePose(frame, T_W_C, inliers) || rescuePose(frame, T_W_C, inliers)) {
     return FrameStatus::kTracked;
   }
@@ -134,8 +134,8 @@ FrameStatus Tracker::Impl::solvePose(const RgbdFrame& frame, const cv::Mat& gray
       (!held_.empty() && relocalize(frame, gray, certainMask(widened), T_W_C, inliers))) {
     return FrameStatus::kRelocalized;
   }
-  posed_by_depth_ = alignToLastDepth(frame, widened.dynamic_mask, T_W_C);
-  return posed_by_depth_ ? FrameStatus::kPosedByDepth : FrameStatus::kLost;
+  return alignToLastDepth(frame, widened.dynamic_mask, T_W_C) ? FrameStatus::kPosedByDepth
+                                                              : FrameStatus::kLost;
 }
 
 // The dense fallback: the static depth aligned to the last tracked frame's, from the predicted
@@ -163,8 +163,10 @@ void Tracker::Impl::commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkP
   if (result.status != FrameStatus::kLost) cullMovedLandmarks(result.T_W_C);
   dropped_.clear();
   // The tracks of a frame posed by depth alone failed to give its pose: the next frame starts
-  // afresh, as after a lost one, but from this pose.
-  if (posed_by_depth_) tracks_.clear();
+  // afresh, as after a lost one, but from this pose. (The frame's status, not a flag a frame
+  // that starts the map would leave stale: that frame's new tracks must stay.)
+  const bool posed_by_depth = result.status == FrameStatus::kPosedByDepth;
+  if (posed_by_depth) tracks_.clear();
   const int restart = config_.restart_after_lost_frames;
   if (result.status == FrameStatus::kLost) {
     result.T_W_C = T_W_last_;
@@ -174,13 +176,14 @@ void Tracker::Impl::commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkP
     if (initialized_ && restart > 0 && ++lost_streak_ >= restart) initialized_ = false;
   } else {
     // Frames posed by depth alone count as lost for the restart: the map restarts at their pose.
-    lost_streak_ = posed_by_depth_ ? lost_streak_ + 1 : 0;
+    lost_streak_ = posed_by_depth ? lost_streak_ + 1 : 0;
     if (restart > 0 && lost_streak_ >= restart) initialized_ = false;
     velocity_ = last_tracked_ ? T_W_last_.inverse() * result.T_W_C : Eigen::Isometry3d::Identity();
     T_W_last_ = result.T_W_C;
     last_tracked_ = true;
     // A copy: the caller may reuse its buffers for the next frame.
-    if (config_.depth_fallback) last_depth_ = {frame.depth_m.clone(), result.dynamic_mask, T_W_last_};
+    if (config_.depth_fallback)
+      last_depth_ = {frame.depth_m.clone(), result.dynamic_mask, T_W_last_};
   }
   result.is_keyframe = static_cast<bool>(result.keyframe);
   record(frame.timestamp_s, result.status, result.T_W_C);

@@ -206,7 +206,6 @@ class Tracker::Impl {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
   PosedDepth last_depth_;        ///< the last tracked frame's depth, moving mask and pose
-  bool posed_by_depth_ = false;  ///< this frame's pose came from alignToLastDepth
 
   std::uint64_t ref_kf_ = 0;
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
