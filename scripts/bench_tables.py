@@ -38,7 +38,8 @@ def main(runs_dir):
         c = r.get("counts", {})
         rows.append({
             "seq": seq, "label": label, "status": r.get("status", "?"),
-            "frames": c.get("frames_read"), "tracked": c.get("tracked", 0) + c.get("relocalized", 0) + c.get("posed_by_depth", 0),
+            "frames": c.get("frames_read"),
+            "tracked": sum(c.get(k, 0) for k in ("tracked", "relocalized", "posed_by_depth")),
             "kf": c.get("keyframes"),
             "ate_cm": m.get("ate", {}).get("rmse_m"), "rpe_t": m.get("rpe", {}).get("trans_rmse_m"),
             "rpe_r": m.get("rpe", {}).get("rot_rmse_deg"),

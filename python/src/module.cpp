@@ -88,7 +88,9 @@ PYBIND11_MODULE(dynamap, m) {
       .def_readonly("timestamp_s", &PyTrackResult::timestamp_s, "The frame's timestamp (s).")
       .def_readonly("pose", &PyTrackResult::pose,
                     "4x4 float64 camera-to-world pose T_W_C (the last known one when lost).")
-      .def_readonly("status", &PyTrackResult::status, "'tracked', 'depth' (posed by the static depth alone), 'relocalized' or 'lost'.")
+      .def_readonly("status", &PyTrackResult::status,
+                    "'tracked', 'depth' (posed by the static depth alone), 'relocalized' or "
+                    "'lost'.")
       .def_readonly("mask", &PyTrackResult::mask,
                     "HxW uint8 dynamic mask of the frame, 255 = moving, 0 = static.")
       .def_readonly("is_keyframe", &PyTrackResult::is_keyframe,

@@ -150,22 +150,21 @@ void scoreResult(const Linearisation& lin, const DepthAlignmentOptions& o, Depth
                  out.weakest_direction_points >= o.min_weakest_direction_points;
 }
 
+/// A posed depth as OpenCV's odometry takes it (its depth pyramid and normals are made once, by
+/// the first ICP run, and kept for the next).
+cv::Ptr<cv::rgbd::OdometryFrame> odometryFrame(const PosedDepth& d) {
+  return cv::rgbd::OdometryFrame::create(cv::Mat(), odometryDepth(d.depth_m),
+                                         odometryMask(d.moving_mask, d.depth_m.size()));
+}
+
 /// OpenCV's point-to-plane ICP from `T_C_R_guess` (T_C_R maps the reference's points into the
 /// current frame), associations up to `max_difference_m` apart; empty if it fails.
-cv::Mat icpStep(const cv::Mat& K, const PosedDepth& reference, const PosedDepth& current,
-                const DepthAlignmentOptions& o, double max_difference_m,
+cv::Mat icpStep(cv::rgbd::ICPOdometry& icp, cv::Ptr<cv::rgbd::OdometryFrame>& reference,
+                cv::Ptr<cv::rgbd::OdometryFrame>& current, double max_difference_m,
                 const cv::Mat& T_C_R_guess) {
-  cv::rgbd::ICPOdometry icp(K, static_cast<float>(o.min_depth_m), static_cast<float>(o.max_depth_m),
-                            static_cast<float>(max_difference_m));
-  icp.setMaxTranslation(o.max_translation_m);
-  icp.setMaxRotation(o.max_rotation_deg);
+  icp.setMaxDepthDiff(max_difference_m);
   cv::Mat T_C_R;
-  const bool solved =
-      icp.compute(cv::Mat(), odometryDepth(reference.depth_m),
-                  odometryMask(reference.moving_mask, reference.depth_m.size()), cv::Mat(),
-                  odometryDepth(current.depth_m),
-                  odometryMask(current.moving_mask, current.depth_m.size()), T_C_R, T_C_R_guess);
-  return solved ? T_C_R : cv::Mat();
+  return icp.compute(reference, current, T_C_R, T_C_R_guess) ? T_C_R : cv::Mat();
 }
 
 }  // namespace
@@ -177,11 +176,16 @@ DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current
   if (reference.depth_m.type() != CV_32FC1 || current.depth_m.type() != CV_32FC1) return out;
   const cv::Mat K =
       (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  cv::rgbd::ICPOdometry icp(K, static_cast<float>(o.min_depth_m),
+                            static_cast<float>(o.max_depth_m));
+  icp.setMaxTranslation(o.max_translation_m);
+  icp.setMaxRotation(o.max_rotation_deg);
+  cv::Ptr<cv::rgbd::OdometryFrame> ref = odometryFrame(reference), cur = odometryFrame(current);
   // Coarse (far associations, to reach the minimum from the guess), then fine (near ones only).
-  const cv::Mat coarse = icpStep(K, reference, current, o, o.coarse_depth_difference_m,
+  const cv::Mat coarse = icpStep(icp, ref, cur, o.coarse_depth_difference_m,
                                  toCv(current.T_W_C.inverse() * reference.T_W_C));
   if (coarse.empty()) return out;
-  const cv::Mat fine = icpStep(K, reference, current, o, o.fine_depth_difference_m, coarse);
+  const cv::Mat fine = icpStep(icp, ref, cur, o.fine_depth_difference_m, coarse);
   const Eigen::Isometry3d T_R_C = fromCv(fine.empty() ? coarse : fine).inverse();
   out.T_W_C = reference.T_W_C * T_R_C;
   scoreResult(

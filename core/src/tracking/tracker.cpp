@@ -182,8 +182,9 @@ void Tracker::Impl::commitFrame(const RgbdFrame& frame, const cv::Mat& gray, LkP
     T_W_last_ = result.T_W_C;
     last_tracked_ = true;
     // A copy: the caller may reuse its buffers for the next frame.
-    if (config_.depth_fallback)
+    if (config_.depth_fallback) {
       last_depth_ = {frame.depth_m.clone(), result.dynamic_mask, T_W_last_};
+    }
   }
   result.is_keyframe = static_cast<bool>(result.keyframe);
   record(frame.timestamp_s, result.status, result.T_W_C);
