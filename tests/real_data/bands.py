@@ -52,6 +52,8 @@ METRICS = {
     "jitter_mm": (("metrics", "rpe_one_frame", "trans_rmse_m"), False),
     "lost_frames": (("frames", "lost"), False),
     "relocalized_frames": (("frames", "relocalized"), False),
+    # Frames whose features gave no pose, posed by the depth fallback alone (status "depth").
+    "posed_by_depth_frames": (("frames", "depth"), False),
     "mask_iou": (("metrics", "masks", "mean_iou"), True),
     "mask_recall": (("metrics", "masks", "pixel_recall"), True),
     "mask_precision": (("metrics", "masks", "pixel_precision"), True),
@@ -146,7 +148,7 @@ def run_dynamap(dynamap, seq, out, overrides=(), config=None, extra=()):
 def read_metrics(out):
     """Every metric of METRICS that the run's outputs hold (ATE in cm)."""
     with open(os.path.join(out, "metrics.json")) as f:
-        found = {"metrics": json.load(f), "frames": {"lost": 0, "relocalized": 0}}
+        found = {"metrics": json.load(f), "frames": {"lost": 0, "relocalized": 0, "depth": 0}}
     for line in open(os.path.join(out, "frames.txt")):
         words = line.split()
         if len(words) >= 2 and words[-1] in found["frames"]:

@@ -28,10 +28,11 @@ def test_reads_ate_in_cm_masks_map_and_frame_states(tmp_path):
         "ate": {"rmse_m": 0.0123}, "masks": {"mean_iou": 0.7, "pixel_recall": 0.9},
         "map": {"precision": 0.95, "ghost_ratio": 0.001}}))
     (tmp_path / "frames.txt").write_text("# t status\n1.0 tracked\n2.0 lost\n3.0 relocalized\n"
-                                         "4.0 lost\n")
+                                         "4.0 lost\n5.0 depth\n6.0 depth\n7.0 depth\n")
     values = bands.read_metrics(str(tmp_path))
     assert abs(values["ate_cm"] - 1.23) < 1e-9
     assert values["lost_frames"] == 2 and values["relocalized_frames"] == 1
+    assert values["posed_by_depth_frames"] == 3
     assert values["mask_iou"] == 0.7 and values["map_ghost_ratio"] == 0.001
     assert "mask_precision" not in values
 
