@@ -6,7 +6,7 @@
   bands.py measure --dynamap BIN [BIN ...] [--cases A,B] [--metrics M,N] [--work DIR]
                                                       run every case's variants, write bands.json
                                                       (--metrics: only those metrics' bands)
-  bands.py sweep --dynamap BIN [--cases A,B] [--set KEY=VALUE ...]
+  bands.py sweep --dynamap BIN [--cases A,B] [--starts A-B] [--set KEY=VALUE ...]
                                                       run each case from every start frame of
                                                       `measure`, print each run and the means
                                                       (judge a change on more than one run)
@@ -265,12 +265,24 @@ def measure(args):
     return 0
 
 
+def parse_starts(text):
+    """'0-11' (a range, both ends in) or '0,3,7': the start frames of a sweep."""
+    try:
+        if "-" in text:
+            first, last = (int(v) for v in text.split("-"))
+            return list(range(first, last + 1))
+        return [int(v) for v in text.split(",")]
+    except ValueError:
+        raise SystemExit("real_data: --starts '%s': expected A-B or A,B,C (frame numbers)" % text)
+
+
 def sweep(args):
     """Each case from every start frame, one build, overrides: each run and the means."""
     cases = args.cases.split(",") if args.cases else list(CASES)
+    starts = parse_starts(args.starts) if args.starts else STARTS
     for case in cases:
         runs = []
-        for start in STARTS:
+        for start in starts:
             seq = prepare(case, start, args.work)
             values = run(args.dynamap[0], case, seq, os.path.join(args.work, case + "_sweep"),
                          args.set)
@@ -338,6 +350,8 @@ def main():
     parser.add_argument("--dynamap", nargs="+", default=[os.path.join(SOURCE, "build/bin/dynamap")])
     parser.add_argument("--builds", nargs="*", help="names of the --dynamap builds (measure)")
     parser.add_argument("--cases", help="comma list (measure, sweep; default all)")
+    parser.add_argument("--starts", help="sweep only: start frames, A-B or A,B,C (default those "
+                        "of measure: 0, 2, ..., 10)")
     parser.add_argument("--metrics", help="comma list: measure only these metrics' bands "
                         "(the others keep theirs; default all)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",

@@ -3,6 +3,8 @@ import json
 import os
 import sys
 
+import pytest
+
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bands  # noqa: E402
 
@@ -41,3 +43,11 @@ def test_every_case_has_bands_for_ate():
     recorded = bands.load_bands()["cases"]
     for case in bands.CASES:
         assert "ate_cm" in recorded.get(case, {}), case
+
+
+def test_sweep_starts_are_a_range_or_a_list_and_anything_else_is_one_clear_error():
+    assert bands.parse_starts("0-11") == list(range(12))
+    assert bands.parse_starts("3") == [3]
+    assert bands.parse_starts("0,3,7") == [0, 3, 7]
+    with pytest.raises(SystemExit, match="--starts 'a-b'"):
+        bands.parse_starts("a-b")
