@@ -157,10 +157,10 @@ void printRunSummary(std::ostream& out, const RunOptions& options, const RunResu
                      const RunReport& report) {
   const RunCounts& c = result.counts;
   out << "run " << result.status << ": " << c.frames_read << " frames read, " << c.tracked
-      << " tracked, " << c.posed_by_depth << " posed by depth, " << c.relocalized << " relocalized, "
-      << c.lost << " lost, " << c.bad_frames
-      << " bad; " << c.keyframes << " keyframes (" << c.culled_keyframes << " more culled); "
-      << report.frames_per_s << " frames/s (" << result.finish_s << " s of it finishing)\n";
+      << " tracked, " << c.posed_by_depth << " posed by depth, " << c.relocalized
+      << " relocalized, " << c.lost << " lost, " << c.bad_frames << " bad; " << c.keyframes
+      << " keyframes (" << c.culled_keyframes << " more culled); " << report.frames_per_s
+      << " frames/s (" << result.finish_s << " s of it finishing)\n";
   if (!result.error.empty()) out << "error: " << result.error << "\n";
   if (report.evaluation) out << evaluationToTable(*report.evaluation);
   if (!report.map_metrics_json.empty()) out << "map: " << report.map_metrics_json << "\n";

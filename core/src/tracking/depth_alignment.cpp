@@ -6,15 +6,13 @@
 #include <vector>
 
 #include <Eigen/Eigenvalues>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/rgbd.hpp>
 
 #include "dynamap/core/rounding.hpp"
 
 namespace dynamap {
 namespace {
-
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 bool usable(const cv::Mat& mask, int x, int y) { return mask.empty() || mask.at<uchar>(y, x) == 0; }
 
@@ -68,18 +66,18 @@ bool surfaceAt(const PosedDepth& ref, const PinholeCamera& camera, const DepthAl
   return true;
 }
 
-/// One association and linearisation pass: H, b of the point-to-plane residuals n.(T p - r)
-/// (twist on the left, in the reference frame), and the residuals of the associated points.
-struct Linearisation {
-  Matrix6d H = Matrix6d::Zero();
-  Vector6d b = Vector6d::Zero();
+/// The current points associated with the reference surface at a pose: their point-to-plane
+/// residuals n.(T p - r), and the translation block of the normal equations, sum of w n n^T
+/// (Huber weights w), which says how well the surfaces pin the translation down.
+struct Association {
+  Eigen::Matrix3d translation_information = Eigen::Matrix3d::Zero();
   std::vector<double> residuals;
 };
 
-Linearisation linearise(const PosedDepth& ref, const std::vector<Eigen::Vector3d>& points,
-                        const Eigen::Isometry3d& T_R_C, const PinholeCamera& camera,
-                        const DepthAlignmentOptions& o, double gate_m) {
-  Linearisation lin;
+Association associate(const PosedDepth& ref, const std::vector<Eigen::Vector3d>& points,
+                      const Eigen::Isometry3d& T_R_C, const PinholeCamera& camera,
+                      const DepthAlignmentOptions& o) {
+  Association association;
   SurfacePoint surface;
   for (const Eigen::Vector3d& p_C : points) {
     const Eigen::Vector3d q = T_R_C * p_C;
@@ -88,16 +86,13 @@ Linearisation linearise(const PosedDepth& ref, const std::vector<Eigen::Vector3d
     const int x = static_cast<int>(roundHalfAway(px.x()));
     const int y = static_cast<int>(roundHalfAway(px.y()));
     if (!surfaceAt(ref, camera, o, x, y, surface)) continue;
-    if ((q - surface.point).norm() > gate_m) continue;
+    if ((q - surface.point).norm() > o.end_gate_m) continue;
     const double e = surface.normal.dot(q - surface.point);
-    Vector6d J;
-    J << surface.normal, q.cross(surface.normal);
     const double w = std::abs(e) <= o.huber_m ? 1.0 : o.huber_m / std::abs(e);
-    lin.H += w * J * J.transpose();
-    lin.b += w * e * J;
-    lin.residuals.push_back(e);
+    association.translation_information += w * surface.normal * surface.normal.transpose();
+    association.residuals.push_back(e);
   }
-  return lin;
+  return association;
 }
 
 /// A depth image for OpenCV's odometry: no reading (0) becomes NaN, which it leaves out.
@@ -112,40 +107,25 @@ cv::Mat odometryMask(const cv::Mat& moving_mask, const cv::Size& size) {
   return moving_mask.empty() ? cv::Mat(size, CV_8UC1, cv::Scalar(255)) : cv::Mat(moving_mask == 0);
 }
 
-cv::Mat toCv(const Eigen::Isometry3d& T) {
-  cv::Mat m(4, 4, CV_64F);
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) m.at<double>(r, c) = T.matrix()(r, c);
-  }
-  return m;
-}
-
-Eigen::Isometry3d fromCv(const cv::Mat& m) {
-  Eigen::Matrix4d e;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) e(r, c) = m.at<double>(r, c);
-  }
-  return Eigen::Isometry3d(e);
-}
-
 /// The smallest eigenvalue of the translation block of the normal equations.
-double weakestDirectionPoints(const Matrix6d& H) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(H.topLeftCorner<3, 3>());
+double weakestDirectionPoints(const Eigen::Matrix3d& translation_information) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(translation_information);
   return solver.eigenvalues().minCoeff();
 }
 
-void scoreResult(const Linearisation& lin, const DepthAlignmentOptions& o, DepthAlignment& out) {
+void scoreResult(const Association& association, const DepthAlignmentOptions& o,
+                 DepthAlignment& out) {
   double sum_sq = 0.0;
-  for (const double e : lin.residuals) {
+  for (const double e : association.residuals) {
     if (std::abs(e) <= o.inlier_m) {
       ++out.inliers;
       sum_sq += e * e;
     }
   }
-  const double associated = static_cast<double>(lin.residuals.size());
+  const double associated = static_cast<double>(association.residuals.size());
   out.inlier_share = associated > 0 ? out.inliers / associated : 0.0;
   out.rms_m = out.inliers > 0 ? std::sqrt(sum_sq / out.inliers) : 0.0;
-  out.weakest_direction_points = weakestDirectionPoints(lin.H);
+  out.weakest_direction_points = weakestDirectionPoints(association.translation_information);
   out.accepted = out.inliers >= o.min_inliers && out.inlier_share >= o.min_inlier_share &&
                  out.weakest_direction_points >= o.min_weakest_direction_points;
 }
@@ -182,15 +162,16 @@ DepthAlignment alignDepth(const PosedDepth& reference, const PosedDepth& current
   icp.setMaxRotation(o.max_rotation_deg);
   cv::Ptr<cv::rgbd::OdometryFrame> ref = odometryFrame(reference), cur = odometryFrame(current);
   // Coarse (far associations, to reach the minimum from the guess), then fine (near ones only).
-  const cv::Mat coarse = icpStep(icp, ref, cur, o.coarse_depth_difference_m,
-                                 toCv(current.T_W_C.inverse() * reference.T_W_C));
+  cv::Mat guess;
+  cv::eigen2cv(Eigen::Matrix4d((current.T_W_C.inverse() * reference.T_W_C).matrix()), guess);
+  const cv::Mat coarse = icpStep(icp, ref, cur, o.coarse_depth_difference_m, guess);
   if (coarse.empty()) return out;
   const cv::Mat fine = icpStep(icp, ref, cur, o.fine_depth_difference_m, coarse);
-  const Eigen::Isometry3d T_R_C = fromCv(fine.empty() ? coarse : fine).inverse();
+  Eigen::Matrix4d T_C_R;
+  cv::cv2eigen(fine.empty() ? coarse : fine, T_C_R);
+  const Eigen::Isometry3d T_R_C = Eigen::Isometry3d(T_C_R).inverse();
   out.T_W_C = reference.T_W_C * T_R_C;
-  scoreResult(
-      linearise(reference, currentPoints(current, camera, o), T_R_C, camera, o, o.end_gate_m), o,
-      out);
+  scoreResult(associate(reference, currentPoints(current, camera, o), T_R_C, camera, o), o, out);
   return out;
 }
 
