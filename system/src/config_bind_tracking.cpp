@@ -46,6 +46,7 @@ void bindTrackingConfig(ConfigSchema& schema, TrackerConfig& c) {
   schema.addDouble("tracking.kf_max_interval_s", &c.kf_max_interval_s, 0.01, 1000.0);
   schema.addDouble("tracking.kf_max_masked_share", &c.kf_max_masked_share, 0.0, 1.0);
   schema.addInt("tracking.kf_crowded_min_tracks", &c.kf_crowded_min_tracks, 0, 100000);
+  schema.addInt("tracking.refind_below_tracks", &c.refind_below_tracks, 0, 100000);
   schema.addDouble("tracking.kf_reuse_distance", &c.kf_reuse_distance, 0.0, 1.0);
   schema.addDouble("tracking.kf_reuse_max_uncovered_share", &c.kf_reuse_max_uncovered_share, 0.0,
                    1.0);

@@ -1,5 +1,6 @@
 // Keyframes while movers fill the view: none for lack of tracks alone (kf_max_masked_share),
-// unless the tracks left are too few to hold the pose (kf_crowded_min_tracks).
+// unless the tracks left are too few to hold the pose (kf_crowded_min_tracks); the landmarks a
+// mover uncovers are found again (refind_below_tracks).
 #include <algorithm>
 
 #include <gtest/gtest.h>
@@ -15,13 +16,15 @@ constexpr double kFramePeriodS = 1.0 / 30.0;
 constexpr int kFrames = 40;
 constexpr int kSlow = 300;  // ~4 mm a frame: the motion limits make a keyframe every 20 frames
 
-/// Masks the left part of the image (as moving) in frames [first, last] only: `first_share` of
-/// its width at `first`, growing by `growth` a frame up to `last_share`.
+/// Masks a band of the image (as moving) in frames [first, last] only: `first_share` of its
+/// width at `first`, growing by `growth` a frame up to `last_share`, from the left border moving
+/// right by `sweep_px` a frame (a walker crossing the view).
 class CrowdedSpanFilter : public MotionFilter {
  public:
   struct Span {
     int first = 10, last = 25;
     double first_share = 0.6, growth = 0.0, last_share = 0.6;
+    int sweep_px = 0;
   };
   CrowdedSpanFilter(int width, int height, Span span)
       : width_(width), height_(height), span_(span) {}
@@ -35,10 +38,13 @@ class CrowdedSpanFilter : public MotionFilter {
     }
     const double share =
         std::min(span_.last_share, span_.first_share + span_.growth * (frame - span_.first));
-    const int masked_cols = static_cast<int>(width_ * share);
+    const int from = std::min(width_, span_.sweep_px * (frame - span_.first));
+    const int to = std::min(width_, from + static_cast<int>(width_ * share));
     out.dynamic_mask = cv::Mat::zeros(height_, width_, CV_8UC1);
-    out.dynamic_mask.colRange(0, masked_cols).setTo(255);
-    for (const auto& p : input.matches->cur_px) out.match_is_dynamic.push_back(p.x < masked_cols);
+    out.dynamic_mask.colRange(from, to).setTo(255);
+    for (const auto& p : input.matches->cur_px) {
+      out.match_is_dynamic.push_back(p.x >= from && p.x < to);
+    }
     return out;
   }
 
@@ -50,6 +56,7 @@ class CrowdedSpanFilter : public MotionFilter {
 
 struct CrowdedRun {
   int keyframes_in_span = 0, tracked = 0;
+  int fewest_inliers_after_span = 1 << 30;  ///< frames 26-39, after the movers left
   double worst_m = 0.0;
 };
 
@@ -72,6 +79,8 @@ CrowdedRun trackThroughACrowd(const TrackerConfig& config, CrowdedSpanFilter::Sp
     const TrackingResult res = tracker.track(frame);
     run.tracked += res.status == FrameStatus::kTracked;
     run.keyframes_in_span += res.is_keyframe && i >= 10 && i <= 25;
+    if (i > 25)
+      run.fewest_inliers_after_span = std::min(run.fewest_inliers_after_span, res.inliers);
   }
   tracker.finish();
   const auto traj = tracker.finalTrajectory();
@@ -84,10 +93,12 @@ CrowdedRun trackThroughACrowd(const TrackerConfig& config, CrowdedSpanFilter::Sp
   return run;
 }
 
-TrackerConfig withMaskedShareLimit(double kf_max_masked_share, int kf_crowded_min_tracks) {
+TrackerConfig withMaskedShareLimit(double kf_max_masked_share, int kf_crowded_min_tracks,
+                                   int refind_below_tracks = 0) {
   TrackerConfig config;
   config.kf_max_masked_share = kf_max_masked_share;
   config.kf_crowded_min_tracks = kf_crowded_min_tracks;
+  config.refind_below_tracks = refind_below_tracks;
   return config;
 }
 
@@ -111,6 +122,22 @@ TEST(SyntheticTracking, AFrameTheMoversFillMakesAKeyframeBeforeItsTracksRunOut) 
   EXPECT_GT(fed.keyframes_in_span, starved.keyframes_in_span);
   EXPECT_EQ(fed.tracked, kFrames);
   EXPECT_LT(fed.worst_m, 0.015);
+}
+
+TEST(SyntheticTracking, LandmarksAWalkerUncoversAreFoundAgainWhileTracksRunShort) {
+  // A band of 40 % of the view crosses it from the left (16 px a frame): every track it passes
+  // over goes, and the landmarks behind it come back into view untracked.
+  const CrowdedSpanFilter::Span crossing{10, 25, 0.4, 0.0, 0.4, 16};
+  const TrackerConfig plain_config = withMaskedShareLimit(0.35, 45, 0);
+  const CrowdedRun plain = trackThroughACrowd(plain_config, crossing);
+  const CrowdedRun refound = trackThroughACrowd(withMaskedShareLimit(0.35, 45, 1000), crossing);
+  EXPECT_EQ(plain.tracked, kFrames);
+  EXPECT_EQ(refound.tracked, kFrames);
+  // Without the search, the view the walker left is tracked again only through the landmarks
+  // of a new keyframe; with it, through the old ones at once.
+  EXPECT_GT(refound.fewest_inliers_after_span, plain.fewest_inliers_after_span);
+  EXPECT_LE(refound.keyframes_in_span, plain.keyframes_in_span);
+  EXPECT_LT(refound.worst_m, 0.015);
 }
 
 }  // namespace

@@ -49,6 +49,14 @@ void Tracker::Impl::mergeTracks(const std::vector<FeatureTrack>& found) {
   tracks_.swap(kept);
 }
 
+void Tracker::Impl::refindLostLandmarks(const RgbdFrame& frame, const cv::Mat& gray,
+                                        const cv::Mat& track_mask,
+                                        const Eigen::Isometry3d& T_W_C_pred) {
+  if (static_cast<int>(tracks_.size()) >= config_.refind_below_tracks) return;
+  ScopedStageTimer timer(timings_, "refind");
+  mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C_pred, localKeyframes(T_W_C_pred)));
+}
+
 double maskedShare(const cv::Mat& mask) {
   return mask.empty() ? 0.0 : cv::countNonZero(mask) / static_cast<double>(mask.total());
 }

@@ -190,6 +190,13 @@ struct TrackerConfig {
   int local_search_keyframes = 10;
   double local_search_radius_px = 10.0;  ///< keypoint within this distance of the projection
   int local_search_max_hamming = 50;     ///< ORB descriptor distance gate
+  /// Tracks run short (walkers cover the view; LK drops the points at their edges): while fewer
+  /// than this many are left after the movers' tracks go, the landmarks of the keyframes near
+  /// the predicted pose that no track follows are searched for among the frame's keypoints
+  /// outside the movers, as revisits do (findMapLandmarks). The pose then keeps leaning on the
+  /// map instead of on the landmarks that each crowded keyframe makes from its own pose, whose
+  /// error they carry on from keyframe to keyframe (0 = off).
+  int refind_below_tracks = 60;
 
   // --- relocalization ---
   /// The newest keyframes whose landmarks are matched, and up to as many of those nearest the

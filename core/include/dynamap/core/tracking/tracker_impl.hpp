@@ -152,6 +152,10 @@ class Tracker::Impl {
                                              const cv::Mat& track_mask,
                                              const Eigen::Isometry3d& T_W_C,
                                              const std::vector<std::uint64_t>& sources);
+  /// Fewer tracks than refind_below_tracks: the local map's landmarks found again among the
+  /// frame's keypoints outside `track_mask`, from the predicted pose.
+  void refindLostLandmarks(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
+                           const Eigen::Isometry3d& T_W_C_pred);
   /// Adds the re-found landmarks' tracks; tracks on the same points (newer landmarks) go.
   void mergeTracks(const std::vector<FeatureTrack>& found);
   std::vector<int> searchLocalMap(const OrbFeatures& features, const std::vector<double>& depth_m,
