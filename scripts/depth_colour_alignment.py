@@ -17,6 +17,8 @@ import cv2
 import numpy as np
 import yaml
 
+from tum_lists import read_list  # the scripts' one reader of rgb.txt / depth.txt
+
 RINGS = [(0, 150), (150, 250), (250, 330), (330, 400)]
 JUMP_M = 0.10
 
@@ -26,10 +28,6 @@ def camera_of(config_path):
         cam = yaml.safe_load(f)["camera"]
     K = np.array([[cam["fx"], 0, cam["cx"]], [0, cam["fy"], cam["cy"]], [0, 0, 1]], float)
     return K, (int(cam.get("width", 640)), int(cam.get("height", 480))), float(cam.get("depth_scale", 5000))
-
-
-def read_list(path):
-    return [line.split() for line in open(path) if line.strip() and not line.startswith("#")]
 
 
 def depth_discontinuities(depth_m):
@@ -69,12 +67,12 @@ def main():
     moved = np.hypot(map_x - xx, map_y - yy)
     print("rings (px from the principal point):", RINGS)
     print("%-12s %s" % ("moved by", " ".join("max %.2f median %.2f" % (moved[r].max(), np.median(moved[r])) for r in rings)))
-    rgb = read_list(args.sequence + "/rgb.txt")
-    depth = read_list(args.sequence + "/depth.txt")
-    depth_t = np.array([float(d[0]) for d in depth])
+    rgb = read_list(args.sequence, "rgb.txt")
+    depth = read_list(args.sequence, "depth.txt")
+    depth_t = np.array([t for t, _ in depth])
     found = {name: [[] for _ in RINGS] for name in ("as is", "both", "colour only")}
     for stamp, name in rgb:
-        nearest = depth[int(np.argmin(np.abs(depth_t - float(stamp))))][1]
+        nearest = depth[int(np.argmin(np.abs(depth_t - stamp)))][1]
         gray = cv2.imread(args.sequence + "/" + name, cv2.IMREAD_GRAYSCALE)
         raw = cv2.imread(args.sequence + "/" + nearest, cv2.IMREAD_UNCHANGED)
         if gray is None or raw is None:
