@@ -166,9 +166,9 @@ struct TrackerConfig {
   /// before, get an acceleration prior on their camera centres (finite differences, in units of
   /// this sigma, m/s^2, Huber-weighted). A hand-held camera's accelerations stay within a few
   /// m/s^2 (the ground truths of teddy and the Bonn slice: at most 1.2 and 0.6 m/s^2 over
-  /// 0.1 s); one-frame jitter of 5 mm is ~9 m/s^2 at 30 Hz. 0 = off. At 5 (BENCHMARKS.md,
-  /// "Crowds on the real Bonn slice"): one-frame translation RPE on the Bonn slice 6.80 -> 5.82 mm forward, 6.86 ->
-  /// 5.81 backward (12 starts each), ATE inside the noise of the means everywhere.
+  /// 0.1 s); one-frame jitter of 5 mm is ~9 m/s^2 at 30 Hz. 0 = off. At 5 (6a9b451,
+  /// docs/design.md): one-frame translation RPE on the Bonn slice 6.80 -> 5.82 mm forward,
+  /// 6.86 -> 5.81 backward (12 starts each), ATE inside the noise of the means everywhere.
   double ba_acceleration_sigma_mps2 = 5.0;
   double ba_acceleration_max_gap_s = 0.25;
   /// The trajectory's frames take their reference keyframe's final pose; where the reference
