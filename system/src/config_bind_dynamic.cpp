@@ -76,6 +76,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.cluster_radius_px", &c.cluster_radius_px, 1.0, 1000.0);
   schema.addInt("dynamic.min_cluster_points", &c.min_cluster_points, 1, 100000);
   schema.addDouble("dynamic.cluster_max_consistent", &c.cluster_max_consistent, 0.0, 1.0);
+  schema.addDouble("dynamic.cluster_max_depth_m", &c.cluster_max_depth_m, 0.0, 100.0);
   schema.addDouble("dynamic.flood_depth_step_m", &c.flood_depth_step_m, 0.001, 10.0);
   schema.addDouble("dynamic.cluster_box_margin", &c.cluster_box_margin, 1.0, 10.0);
 }

@@ -65,5 +65,29 @@ TEST(ClusterInPlace, WithoutAnEarlierViewOrTheCheckBothClustersAreMasked) {
   EXPECT_GT(maskedShare(b.mask, s.mover), 0.95);
 }
 
+// The wall 6 m away, beyond the range where the sensor's depth says a surface moved
+// (cluster_max_depth_m, 5 m), and no earlier view: the flagged patch on it is not masked, the mover
+// at 1.5 m is. With no range both are.
+TEST(ClusterInPlace, FlagsOnAWallBeyondTheTrustedDepthMaskNothing) {
+  ClusterScene s;
+  s.depth.setTo(6.f);
+  s.depth(s.mover).setTo(1.5f);
+  s.evidence.view = nullptr;
+  DynamicConfig c;
+  RegionFusion fusion(c, ClassTable(c));
+  const FusionResult r =
+      fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  EXPECT_EQ(r.clusters, 1);
+  EXPECT_GT(maskedShare(r.mask, s.mover), 0.95);
+  EXPECT_LT(maskedShare(r.mask, s.false_flags), 0.01);
+
+  c.cluster_max_depth_m = 0.0;  // any range
+  RegionFusion any_range(c, ClassTable(c));
+  const FusionResult b =
+      any_range.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  EXPECT_EQ(b.clusters, 2);
+  EXPECT_GT(maskedShare(b.mask, s.false_flags), 0.95);
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -51,6 +51,24 @@ bool inPlaceEarlier(const cv::Mat& depth_m, const cv::Mat& region, const cv::Rec
   return a.samples >= kInPlaceMinSamples && a.share(a.consistent) >= share;
 }
 
+/// True if most of the group's points with depth lie beyond `max_m` (0 = no range): there the
+/// sensor's depth bends and jumps by tens of centimetres from view to view, and neither the
+/// flags nor the earlier view's verdict say the surface moved.
+bool beyondRange(const cv::Mat& depth_m, const std::vector<int>& group,
+                 const std::vector<cv::Point2f>& points, double max_m) {
+  if (max_m <= 0.0) return false;
+  int with_depth = 0, far = 0;
+  for (int i : group) {
+    const cv::Point p(cvRound(points[i].x), cvRound(points[i].y));
+    if (p.x < 0 || p.y < 0 || p.x >= depth_m.cols || p.y >= depth_m.rows) continue;
+    const float z = depth_m.at<float>(p);
+    if (z <= 0.f) continue;
+    ++with_depth;
+    far += z > max_m ? 1 : 0;
+  }
+  return 2 * far > with_depth && with_depth > 0;
+}
+
 /// Support: most tracked points around the cluster (its tight box and 10 px) must be dynamic,
 /// else it is noise.
 bool supported(const std::vector<int>& group, const cv::Rect& tight,
@@ -145,6 +163,7 @@ int growClusters(const cv::Mat& depth_m, const std::vector<cv::Point2f>& points,
     for (int i : group) gp.push_back(points[i]);
     const cv::Rect tight = cv::boundingRect(gp);
     if (!supported(group, tight, points)) continue;
+    if (beyondRange(depth_m, group, points, config.cluster_max_depth_m)) continue;
     const cv::Rect roi = growthRoi(tight, depth_m.size(), config);
     cv::Mat filled = floodFromPoints(depth_m, group, roi, points, claimed, evidence, config);
     carveStatic(filled, roi, points, dyn, evidence.proven_static, config.static_carve_radius_px);

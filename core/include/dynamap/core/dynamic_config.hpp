@@ -183,6 +183,14 @@ struct DynamicConfig {
   /// a still surface under false flags (tracks dragged beside a walker, a far poster), not a
   /// mover: it is not masked. 0 = off (also without dense_check_frames).
   double cluster_max_consistent = 0.9;
+  /// A cluster whose flagged points lie mostly beyond this depth (m; 0 = any) is not grown nor
+  /// masked: that far a structured-light sensor's depth bends and jumps by tens of centimetres
+  /// from view to view, the check above sees it "seen through", and the map (4 m) takes none of
+  /// it (crowd played backward: a wall at 6-7 m behind an open door, 13 k pixels masked in a
+  /// keyframe). Not the movers' 4 m: the flood from a walker's points at 4-4.5 m reaches his
+  /// nearer legs, which the map takes (crowd x10 with 4: keyframe-mask IoU .766 -> .717, ghost
+  /// .03 -> .29 %). BENCHMARKS.md, "Long runs".
+  double cluster_max_depth_m = 5.0;
   double flood_depth_step_m = 0.03;  ///< depth continuity of the flood fill from clusters
   double cluster_box_margin = 1.5;   ///< flood fill stays inside cluster box grown by this
 };
