@@ -36,12 +36,15 @@ struct ClusterScene {
 
 using test::maskedShare;
 
+FusionResult fuseScene(const ClusterScene& s, const DynamicConfig& c) {
+  RegionFusion fusion(c, ClassTable(c));
+  return fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+}
+
 TEST(ClusterInPlace, AClusterTheEarlierViewSawInPlaceIsNotMasked) {
   ClusterScene s;
   DynamicConfig c;
-  RegionFusion fusion(c, ClassTable(c));
-  const FusionResult r =
-      fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  const FusionResult r = fuseScene(s, c);
   EXPECT_EQ(r.clusters, 1);
   EXPECT_GT(maskedShare(r.mask, s.mover), 0.95);
   EXPECT_LT(maskedShare(r.mask, s.false_flags), 0.01);
@@ -51,16 +54,13 @@ TEST(ClusterInPlace, WithoutAnEarlierViewOrTheCheckBothClustersAreMasked) {
   ClusterScene s;
   DynamicConfig c;
   s.evidence.view = nullptr;
-  RegionFusion no_view(c, ClassTable(c));
-  const FusionResult a =
-      no_view.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  const FusionResult a = fuseScene(s, c);
   EXPECT_EQ(a.clusters, 2);
   EXPECT_GT(maskedShare(a.mask, s.false_flags), 0.95);
 
   s.evidence.view = &s.view;
   c.cluster_max_consistent = 0.0;  // off
-  RegionFusion off(c, ClassTable(c));
-  const FusionResult b = off.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  const FusionResult b = fuseScene(s, c);
   EXPECT_EQ(b.clusters, 2);
   EXPECT_GT(maskedShare(b.mask, s.mover), 0.95);
 }
@@ -74,17 +74,13 @@ TEST(ClusterInPlace, FlagsOnAWallBeyondTheTrustedDepthMaskNothing) {
   s.depth(s.mover).setTo(1.5f);
   s.evidence.view = nullptr;
   DynamicConfig c;
-  RegionFusion fusion(c, ClassTable(c));
-  const FusionResult r =
-      fusion.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  const FusionResult r = fuseScene(s, c);
   EXPECT_EQ(r.clusters, 1);
   EXPECT_GT(maskedShare(r.mask, s.mover), 0.95);
   EXPECT_LT(maskedShare(r.mask, s.false_flags), 0.01);
 
   c.cluster_max_depth_m = 0.0;  // any range
-  RegionFusion any_range(c, ClassTable(c));
-  const FusionResult b =
-      any_range.fuse(FusionMode::kBoth, s.depth, s.points, s.dynamic, {}, s.evidence);
+  const FusionResult b = fuseScene(s, c);
   EXPECT_EQ(b.clusters, 2);
   EXPECT_GT(maskedShare(b.mask, s.false_flags), 0.95);
 }
