@@ -128,8 +128,7 @@ TEST(SyntheticTracking, LandmarksAWalkerUncoversAreFoundAgainWhileTracksRunShort
   // A band of 40 % of the view crosses it from the left (16 px a frame): every track it passes
   // over goes, and the landmarks behind it come back into view untracked.
   const CrowdedSpanFilter::Span crossing{10, 25, 0.4, 0.0, 0.4, 16};
-  const TrackerConfig plain_config = withMaskedShareLimit(0.35, 45, 0);
-  const CrowdedRun plain = trackThroughACrowd(plain_config, crossing);
+  const CrowdedRun plain = trackThroughACrowd(withMaskedShareLimit(0.35, 45, 0), crossing);
   const CrowdedRun refound = trackThroughACrowd(withMaskedShareLimit(0.35, 45, 1000), crossing);
   EXPECT_EQ(plain.tracked, kFrames);
   EXPECT_EQ(refound.tracked, kFrames);
