@@ -4,9 +4,13 @@ frames/s, masks and map, for sequences played N times forward and backward by
 ../shared/tools/make_long.py.
 
 Usage: bench_long.py [--dynamap BIN] [--out DIR] [--cases a,b] [--backends b1,b2] [--passes N]
+                      [--spans A-B,C-D]
 Prints a markdown table (one row per case and backend: the single pass, the long run and their
 ratios, and the keyframes each pass of the long run added: where the growth is) and writes it
-to OUT/long.md. The long sequences are made under /tmp on first use.
+to OUT/long.md. The long sequences are made under /tmp on first use. --spans plays frames A..B
+of each case instead of the whole source (the single pass A..B, the long run A..B, B..A, ...):
+variants of one sequence, whose spread tells how far one run's ratios and mask gap are noise; a
+second table gives each case's mean, smallest and largest over the spans.
 Standard library only (make_long.py needs Debian's numpy).
 """
 import argparse
@@ -31,15 +35,33 @@ CASES = {
 }
 
 
-def long_sequence(name, passes):
-    """The sequence played `passes` times (forward, backward, ...), made once under /tmp."""
+def played_sequence(name, passes, span=None):
+    """Frames span = (first, last) of the case (None: all) played `passes` times (forward,
+    backward, ...), made once under /tmp; the whole source itself for one pass of all."""
     src, frames, _ = CASES[name]
-    out = f"/tmp/{name}_x{passes}"
+    if span is None and passes == 1:
+        return src
+    first, last = span if span is not None else (0, frames - 1)
+    tag = "" if span is None else f"_{first}_{last}"
+    out = f"/tmp/{name}{tag}_x{passes}"
     if not os.path.isfile(os.path.join(out, "rgb.txt")):
-        ends = [str(0 if i % 2 == 0 else frames - 1) for i in range(passes + 1)]
+        ends = [str(first if i % 2 == 0 else last) for i in range(passes + 1)]
         subprocess.run(["/usr/bin/python3", f"{SHARED}/tools/make_long.py", src, out,
                         ",".join(ends)], check=True, stdout=subprocess.DEVNULL)
     return out
+
+
+def parse_spans(text):
+    """'A-B,C-D' -> [(A, B), (C, D)]; empty -> [None] (the whole source)."""
+    if not text:
+        return [None]
+    spans = []
+    for item in text.split(","):
+        first, _, last = item.partition("-")
+        if not (first.isdigit() and last.isdigit() and int(first) < int(last)):
+            sys.exit(f"bench_long.py: --spans: '{item}' is not FIRST-LAST (frames, FIRST < LAST)")
+        spans.append((int(first), int(last)))
+    return spans
 
 
 def tum_rows(path):
@@ -116,6 +138,29 @@ def row(case, backend, one, many):
     return "| " + " | ".join(cells) + " |"
 
 
+def spread(values, digits, signed=False):
+    """'mean (min, max)' of the values that are there."""
+    v = [x for x in values if x is not None]
+    if not v:
+        return "–"
+    f = f"{{:{'+' if signed else ''}.{digits}f}}"
+    return f"{f.format(sum(v) / len(v))} ({f.format(min(v))}, {f.format(max(v))})"
+
+
+def summary(pairs):
+    """One row per case and backend over its spans: the long run against its single pass."""
+    lines = ["| case | backend | spans | mask IoU long - single | keyframes (x) | ATE (x) | "
+             "peak memory (x) |", "|---" * 7 + "|"]
+    for (case, backend), runs in pairs.items():
+        gap = [m["iou"] - o["iou"] if None not in (m["iou"], o["iou"]) else None for o, m in runs]
+        ratios = {k: [m[k] / o[k] if m[k] is not None and o[k] else None for o, m in runs]
+                  for k in ("kf", "ate", "mem")}
+        lines.append(f"| {case} | {backend} | {len(runs)} | {spread(gap, 3, True)} | "
+                     f"{spread(ratios['kf'], 2)} | {spread(ratios['ate'], 2)} | "
+                     f"{spread(ratios['mem'], 2)} |")
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--dynamap", default=os.path.join(ROOT, "build/bin/dynamap"))
@@ -124,15 +169,19 @@ def main():
     ap.add_argument("--backends", default="default")
     ap.add_argument("--passes", type=int, default=10)
     ap.add_argument("--set", action="append", default=[], help="extra section.key=value")
+    ap.add_argument("--spans", default="", help="FIRST-LAST,...: variants (frames of the case)")
     a = ap.parse_args()
+    spans = parse_spans(a.spans)
     os.makedirs(a.out, exist_ok=True)
     header = ("| case | backend | frames 1 / N | keyframes (x) | peak MiB (x) | ATE cm (x) | "
               "finish s | frames/s | mask IoU | map precision | ghost | new keyframes per pass |\n" +
               "|---" * 12 + "|")
-    lines = [header]
-    for case in a.cases.split(","):
-        src, _, options = CASES[case]
-        seq_long = long_sequence(case, a.passes)
+    lines, pairs = [header], {}
+    for case, span in ((c, s) for c in a.cases.split(",") for s in spans):
+        _, _, options = CASES[case]
+        name = case if span is None else f"{case} {span[0]}-{span[1]}"
+        seq_one = played_sequence(case, 1, span)
+        seq_long = played_sequence(case, a.passes, span)
         starts = pass_starts(seq_long)
         for backend in a.backends.split(","):
             opts = list(options)
@@ -140,12 +189,15 @@ def main():
                 opts += ["--set", f"mapping.backend={backend}"]
             for kv in a.set:
                 opts += ["--set", kv]
-            one = run(a.dynamap, src, f"{a.out}/{case}__{backend}__x1", opts)
-            out_long = f"{a.out}/{case}__{backend}__x{a.passes}"
-            many = run(a.dynamap, seq_long, out_long, opts)
-            many["per_pass"] = keyframes_per_pass(out_long, starts)
-            lines.append(row(case, backend, one, many))
+            folder = f"{a.out}/{name.replace(' ', '_')}__{backend}"
+            one = run(a.dynamap, seq_one, folder + "__x1", opts)
+            many = run(a.dynamap, seq_long, f"{folder}__x{a.passes}", opts)
+            many["per_pass"] = keyframes_per_pass(f"{folder}__x{a.passes}", starts)
+            pairs.setdefault((case, backend), []).append((one, many))
+            lines.append(row(name, backend, one, many))
             print(lines[-1], flush=True)
+    if len(spans) > 1:
+        lines += [""] + summary(pairs)
     with open(os.path.join(a.out, "long.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
