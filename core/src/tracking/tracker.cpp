@@ -40,6 +40,7 @@ Tracker::Impl::Impl(const PinholeCamera& camera, const TrackerConfig& config,
 // The per-frame step: match -> dynamic filter -> pose (with its fallbacks) -> keyframe -> commit.
 TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   ScopedStageTimer total(timings_, "tracking");
+  ++frame_serial_;  // the searches' keypoints of the last frame are stale
   // Realtime: a loop correction lands as soon as it is ready (lockstep: at the next keyframe).
   if (loop_ && !config_.ba_lockstep) applyLoopCorrections(loop_->takeCorrections(), nullptr);
   if (frame.depth_m.empty() || cv::countNonZero(frame.depth_m) == 0) return poseWithoutDepth(frame);

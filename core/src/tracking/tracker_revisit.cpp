@@ -83,6 +83,20 @@ std::vector<std::uint64_t> Tracker::Impl::localKeyframes(const Eigen::Isometry3d
   return ids;
 }
 
+const OrbFeatures& Tracker::Impl::searchKeypoints(const cv::Mat& gray, const cv::Mat& track_mask) {
+  SearchKeypoints& cache = search_keypoints_;
+  const bool same_mask = cache.track_mask.data == track_mask.data &&
+                         cache.track_mask.size() == track_mask.size();
+  if (cache.frame_serial == frame_serial_ && same_mask) return cache.features;
+  ScopedStageTimer orb_timer(timings_, "orb");
+  cv::Mat allowed;
+  if (!track_mask.empty()) allowed = track_mask != 255;
+  cache.features = extractor_.extractForSearch(gray, allowed);
+  cache.frame_serial = frame_serial_;
+  cache.track_mask = track_mask;
+  return cache.features;
+}
+
 // The landmarks of `sources` that the frame's tracks do not follow, found among
 // the frame's ORB keypoints (outside track_mask) by projection.
 std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(
@@ -90,13 +104,7 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(
     const Eigen::Isometry3d& T_W_C, const std::vector<std::uint64_t>& sources) {
   const LandmarkCandidates candidates =
       withoutLandmarks(map_.landmarksOf(sources), trackedLandmarks());
-  OrbFeatures features;
-  {
-    ScopedStageTimer orb_timer(timings_, "orb");
-    cv::Mat allowed;
-    if (!track_mask.empty()) allowed = track_mask != 255;
-    features = extractor_.extractForSearch(gray, allowed);
-  }
+  const OrbFeatures& features = searchKeypoints(gray, track_mask);
   std::vector<double> depth(features.keypoints.size());
   for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
     const cv::Point2f& p = features.keypoints[i].pt;

@@ -147,6 +147,10 @@ class Tracker::Impl {
   /// The newest local_search_keyframes keyframes, then those near T_W_C (keyframe limits).
   std::vector<std::uint64_t> localKeyframes(const Eigen::Isometry3d& T_W_C) const;
   std::vector<std::uint64_t> trackedLandmarks() const;
+  /// The frame's keypoints for the searches (extractForSearch outside `track_mask`), extracted
+  /// once per frame and mask: the lost-landmark search, a revisit and the redundancy check of
+  /// one frame search the same ones.
+  const OrbFeatures& searchKeypoints(const cv::Mat& gray, const cv::Mat& track_mask);
   /// The landmarks of `sources` the tracks do not follow, found among the frame's keypoints.
   std::vector<FeatureTrack> findMapLandmarks(const RgbdFrame& frame, const cv::Mat& gray,
                                              const cv::Mat& track_mask,
@@ -210,6 +214,14 @@ class Tracker::Impl {
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
   bool last_tracked_ = false;
   PosedDepth last_depth_;        ///< the last tracked frame's depth, moving mask and pose
+
+  std::uint64_t frame_serial_ = 0;  ///< track() calls so far: which frame a cache belongs to
+  struct SearchKeypoints {
+    std::uint64_t frame_serial = 0;
+    cv::Mat track_mask;  ///< held: its buffer cannot be another mask's while cached
+    OrbFeatures features;
+  };
+  SearchKeypoints search_keypoints_;  ///< searchKeypoints()'s, of frame frame_serial (0: none)
 
   std::uint64_t ref_kf_ = 0;
   Eigen::Isometry3d ref_T_W_C_ = Eigen::Isometry3d::Identity();
