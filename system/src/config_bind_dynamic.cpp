@@ -60,6 +60,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.dense_depth_range_m", &c.dense_depth_range_m, 0.001, 10.0);
   schema.addDouble("dynamic.dense_grow_m", &c.dense_grow_m, 0.0, 10.0);
   schema.addDouble("dynamic.dense_barrier_step_m", &c.dense_barrier_step_m, 0.0, 10.0);
+  schema.addBool("dynamic.views_follow_pose_snaps", &c.views_follow_pose_snaps);
   schema.addBool("dynamic.mover_tracks", &c.mover_tracks);
   schema.addBool("dynamic.hold_moved_objects", &c.hold_moved_objects);
   schema.addBool("dynamic.mover_follow_anchors", &c.mover_follow_anchors);

@@ -210,5 +210,34 @@ TEST(DepthHistory, KeepsRecentViewsAndFindsTheNewestOldEnoughOne) {
   EXPECT_EQ(off.newestUpTo(0), nullptr);
 }
 
+TEST(DepthHistory, EarlierViewsFollowAPoseSnapAndAStillRoomIsSeenThroughNoMore) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  test::SyntheticScene scene(camera, 7);
+  scene.addDefaultRoom();
+  // The tracker drifted 2 deg about the vertical before frame 6, whose pose then snapped back to
+  // the truth: the view of frame 0 was kept with the drifted pose.
+  const Eigen::Isometry3d drift(Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  DepthHistory history(12);
+  history.push(viewOf(scene.render(cameraAt(0), 0.0), drift * cameraAt(0), 0));
+  const auto now = scene.render(cameraAt(6), 6 * kFramePeriodS);
+  const cv::Rect all(0, 0, camera.width, camera.height);
+  const auto seenThrough = [&]() {
+    const DepthAgreement a = compareWithView(now.depth_m, cv::Mat(), all, toMatx(cameraAt(6)),
+                                             intrinsics(camera), *history.newestUpTo(0),
+                                             DepthCheckOptions());
+    return a.share(a.seen_through);
+  };
+  ASSERT_NE(history.newestUpTo(0), nullptr);
+  const double across_the_jump = seenThrough();
+  EXPECT_GT(across_the_jump, 0.01);  // the still room looks moved (a still one: < .001)
+  // A refinement within 1 deg and 1 cm moves nothing.
+  const Eigen::Isometry3d nudge(Eigen::AngleAxisd(0.5 * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+  EXPECT_FALSE(history.followPoseSnap(toMatx(nudge * cameraAt(6)), toMatx(cameraAt(6))));
+  EXPECT_DOUBLE_EQ(seenThrough(), across_the_jump);
+  // The snap: checked with the drifted pose, final at the truth.
+  EXPECT_TRUE(history.followPoseSnap(toMatx(cameraAt(6)), toMatx(drift * cameraAt(6))));
+  EXPECT_LT(seenThrough(), 0.001);
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -147,6 +147,16 @@ void DepthHistory::push(DepthView view) {
   while (!views_.empty() && views_.front().frame < frame - max_age_) views_.pop_front();
 }
 
+bool DepthHistory::followPoseSnap(const cv::Matx44d& T_W_final, const cv::Matx44d& T_W_prior) {
+  const cv::Matx44d S = T_W_final * T_W_prior.inv(cv::DECOMP_SVD);
+  const double moved_m = std::hypot(S(0, 3), S(1, 3), S(2, 3));
+  const double cos_turn = std::clamp((S(0, 0) + S(1, 1) + S(2, 2) - 1.0) / 2.0, -1.0, 1.0);
+  const double turned_deg = std::acos(cos_turn) * 180.0 / M_PI;
+  if (moved_m <= kPoseSnapM && turned_deg <= kPoseSnapDeg) return false;
+  for (DepthView& view : views_) view.T_W_C = S * view.T_W_C;
+  return true;
+}
+
 const DepthView* DepthHistory::newestUpTo(long last_frame) const {
   for (auto it = views_.rbegin(); it != views_.rend(); ++it) {
     if (it->frame <= last_frame) return &*it;

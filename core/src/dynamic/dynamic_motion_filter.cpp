@@ -272,6 +272,8 @@ void DynamicMotionFilter::keepLastDepth(const MotionFilterInput& input) {
   // The last frame's final pose: X_W = T_W_C T_prev_cur^-1 X_prev.
   cv::eigen2cv(Eigen::Matrix4d((input.T_W_C * input.T_prev_cur.inverse()).matrix()),
                pending_.T_W_C);
+  if (config_.views_follow_pose_snaps && pending_has_prior_)
+    depth_history_.followPoseSnap(pending_.T_W_C, pending_prior_);
   depth_history_.push(std::move(pending_));
 }
 
@@ -398,7 +400,8 @@ FusionResult DynamicMotionFilter::fuseRegions(const MotionFilterInput& input,
   return fused;
 }
 
-void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const FusionResult& fused) {
+void DynamicMotionFilter::endFrame(const MotionFilterInput& input, const cv::Mat& depth_m,
+                                   const FusionResult& fused) {
   prev_mask_ = fused.mask;
   if (moverTracks()) prev_kept_movers_ = keptMovers(fused);
   prev_people_.clear();
@@ -412,6 +415,8 @@ void DynamicMotionFilter::endFrame(const cv::Mat& depth_m, const FusionResult& f
   }
   pending_ = DepthView();
   if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);
+  pending_has_prior_ = input.has_prior;
+  if (input.has_prior) cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), pending_prior_);
   ++filtered_;
 }
 
@@ -443,7 +448,7 @@ MotionFilterOutput DynamicMotionFilter::filter(const MotionFilterInput& input) {
   addMovers(depth_m, evidence, dets);  // records "movers"
   FusionResult fused = fuseRegions(input, m, depth_m, dets, epi, evidence);
   MotionFilterOutput out = filterOutput(m.cur_px, epi.is_dynamic, fused);
-  endFrame(depth_m, fused);
+  endFrame(input, depth_m, fused);
   keepDiagnostics(m, epi, out, std::move(dets), std::move(fused));
   return out;
 }

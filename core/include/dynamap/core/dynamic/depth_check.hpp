@@ -124,6 +124,13 @@ class DepthHistory {
   /// The newest kept view taken no later than `last_frame`; null if there is none.
   const DepthView* newestUpTo(long last_frame) const;
   void clear() { views_.clear(); }
+  /// A frame whose final pose `T_W_final` moved from the pose its check used (`T_W_prior`) by
+  /// more than kPoseSnapDeg or kPoseSnapM (the tracker corrected drift at once, e.g. landmarks
+  /// found again): every kept view moves with the same correction, so later frames compare with
+  /// views in the corrected frame, not across the jump. True if it moved them.
+  bool followPoseSnap(const cv::Matx44d& T_W_final, const cv::Matx44d& T_W_prior);
+  static constexpr double kPoseSnapDeg = 1.0;
+  static constexpr double kPoseSnapM = 0.01;
 
  private:
   int max_age_;

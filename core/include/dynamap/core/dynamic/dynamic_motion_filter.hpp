@@ -73,7 +73,8 @@ class DynamicMotionFilter : public MotionFilter {
   /// latest_, if there are any.
   void takeDetections(bool wait);
   /// Moves the last frame's depth (pending_) into the history with its final pose, which this
-  /// frame's input brings (input.has_prior).
+  /// frame's input brings (input.has_prior); if that pose jumped from the one the last frame
+  /// was checked with, the older views follow it (views_follow_pose_snaps).
   void keepLastDepth(const MotionFilterInput& input);
   /// The dense check (DynamicConfig::dense_check_frames): what the frame that many frames back
   /// saw through, outside fusion's objects, is added to the mask. No group starts on a support
@@ -106,8 +107,9 @@ class DynamicMotionFilter : public MotionFilter {
   FusionResult fuseRegions(const MotionFilterInput& input, const FeatureMatches& m,
                            const cv::Mat& depth_m, const std::vector<Detection>& dets,
                            const EpipolarResult& epi, FusionEvidence& evidence);
-  /// What the next frame needs of this one: its masks and (dense check) its depth.
-  void endFrame(const cv::Mat& depth_m, const FusionResult& fused);
+  /// What the next frame needs of this one: its masks and (dense check) its depth and the pose
+  /// it was checked with.
+  void endFrame(const MotionFilterInput& input, const cv::Mat& depth_m, const FusionResult& fused);
   void keepDiagnostics(const FeatureMatches& m, const EpipolarResult& epi,
                        const MotionFilterOutput& out, std::vector<Detection> dets,
                        FusionResult fused);
@@ -139,6 +141,8 @@ class DynamicMotionFilter : public MotionFilter {
   /// waits in pending_ until the next filter() call brings its final pose.
   DepthHistory depth_history_;
   DepthView pending_;
+  bool pending_has_prior_ = false;
+  cv::Matx44d pending_prior_ = cv::Matx44d::eye();  ///< the pose pending_'s frame was checked with
   long filtered_ = 0;  ///< filter() calls so far
 };
 
