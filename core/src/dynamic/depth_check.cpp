@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/Geometry>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace dynamap {
@@ -149,10 +151,10 @@ void DepthHistory::push(DepthView view) {
 
 bool DepthHistory::followPoseSnap(const cv::Matx44d& T_W_final, const cv::Matx44d& T_W_prior) {
   const cv::Matx44d S = T_W_final * T_W_prior.inv(cv::DECOMP_SVD);
-  const double moved_m = std::hypot(S(0, 3), S(1, 3), S(2, 3));
-  const double cos_turn = std::clamp((S(0, 0) + S(1, 1) + S(2, 2) - 1.0) / 2.0, -1.0, 1.0);
-  const double turned_deg = std::acos(cos_turn) * 180.0 / M_PI;
-  if (moved_m <= kPoseSnapM && turned_deg <= kPoseSnapDeg) return false;
+  Eigen::Matrix4d s;
+  cv::cv2eigen(S, s);
+  const double turned_deg = Eigen::AngleAxisd(s.topLeftCorner<3, 3>()).angle() * 180.0 / M_PI;
+  if (s.topRightCorner<3, 1>().norm() <= kPoseSnapM && turned_deg <= kPoseSnapDeg) return false;
   for (DepthView& view : views_) view.T_W_C = S * view.T_W_C;
   return true;
 }

@@ -272,8 +272,8 @@ void DynamicMotionFilter::keepLastDepth(const MotionFilterInput& input) {
   // The last frame's final pose: X_W = T_W_C T_prev_cur^-1 X_prev.
   cv::eigen2cv(Eigen::Matrix4d((input.T_W_C * input.T_prev_cur.inverse()).matrix()),
                pending_.T_W_C);
-  if (config_.views_follow_pose_snaps && pending_has_prior_)
-    depth_history_.followPoseSnap(pending_.T_W_C, pending_prior_);
+  if (config_.views_follow_pose_snaps && pending_prior_)
+    depth_history_.followPoseSnap(pending_.T_W_C, *pending_prior_);
   depth_history_.push(std::move(pending_));
 }
 
@@ -415,8 +415,12 @@ void DynamicMotionFilter::endFrame(const MotionFilterInput& input, const cv::Mat
   }
   pending_ = DepthView();
   if (config_.dense_check_frames > 0) pending_ = DepthHistory::halfView(depth_m, filtered_);
-  pending_has_prior_ = input.has_prior;
-  if (input.has_prior) cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), pending_prior_);
+  pending_prior_.reset();
+  if (input.has_prior) {
+    cv::Matx44d prior;
+    cv::eigen2cv(Eigen::Matrix4d(input.T_W_C.matrix()), prior);
+    pending_prior_ = prior;
+  }
   ++filtered_;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -141,8 +142,7 @@ class DynamicMotionFilter : public MotionFilter {
   /// waits in pending_ until the next filter() call brings its final pose.
   DepthHistory depth_history_;
   DepthView pending_;
-  bool pending_has_prior_ = false;
-  cv::Matx44d pending_prior_ = cv::Matx44d::eye();  ///< the pose pending_'s frame was checked with
+  std::optional<cv::Matx44d> pending_prior_;  ///< the pose pending_'s frame was checked with
   long filtered_ = 0;  ///< filter() calls so far
 };
 
