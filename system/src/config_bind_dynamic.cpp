@@ -54,6 +54,7 @@ void bindDynamicConfig(ConfigSchema& schema, DynamicConfig& c) {
   schema.addDouble("dynamic.static_anchor_px", &c.static_anchor_px, 0.0, 1000.0);
   schema.addDouble("dynamic.static_anchor_m", &c.static_anchor_m, 0.0, 1.0);
   schema.addDouble("dynamic.static_anchor_depth_m", &c.static_anchor_depth_m, 0.001, 10.0);
+  schema.addDouble("dynamic.static_surface_m", &c.static_surface_m, 0.0, 1.0);
   schema.addInt("dynamic.static_anchor_move_frames", &c.static_anchor_move_frames, 1, 2);
   schema.addInt("dynamic.dense_check_frames", &c.dense_check_frames, 0, 120);
   schema.addInt("dynamic.dense_min_region_px", &c.dense_min_region_px, 1, 1000000);

@@ -29,6 +29,29 @@ inline FusionEvidence stillCameraEvidence(std::size_t points, bool with_ids) {
   return ev;
 }
 
+/// A still person's box for keptShare() (his pixels: kStillPerson).
+const cv::Rect kStillPerson(280, 120, 90, 260);
+const Detection kStillPersonBox{cv::Rect2f(270, 110, 110, 280), 0, 0.9f};
+
+/// Share of `frames` frames in which the person of kStillPersonBox is kept (not masked), given
+/// each frame's depth `depth_at(i)`. The camera is still, his tracked points (ids `with_ids`)
+/// keep their pixels and are never flagged: a frame-to-frame check sees nothing.
+template <typename DepthAt>
+double keptShare(const DynamicConfig& c, int frames, DepthAt depth_at, bool with_ids) {
+  const std::vector<cv::Point2f> points = pointGrid();
+  const std::vector<std::uint8_t> quiet(points.size(), 0);
+  const FusionEvidence ev = stillCameraEvidence(points.size(), with_ids);
+  RegionFusion fusion(c, ClassTable(c));
+  int kept = 0;
+  for (int i = 0; i < frames; ++i) {
+    const cv::Mat depth = depth_at(i);
+    kept += !fusion.fuse(FusionMode::kBoth, depth, points, quiet, {kStillPersonBox}, ev)
+                 .objects.at(0)
+                 .moving;
+  }
+  return kept / static_cast<double>(frames);
+}
+
 /// A frame with a person 2 m away (kSidewaysPerson) in front of a wall 5 m away: a point every
 /// 10 px, those on him shifted `shift` px sideways (and flagged with `flag_person`), ids in `ev`.
 const cv::Rect kSidewaysPerson(280, 120, 90, 260);

@@ -37,21 +37,23 @@ cv::Mat drawMotionDebug(const cv::Mat& bgr, const MotionDiagnostics& d, const Cl
 
 std::string objectLogHeader() {
   return "# stamp\tclass\tscore\tx\ty\tw\th\tdepth_m\tpoints\tdynamic\tanchored\t"
-         "anchor_px\tanchor_dz_m\tquiet\tcarried\tmoving_now\tmoving\n";
+         "anchor_px\tanchor_dz_m\tsurface_points\tsurface_dz_m\tquiet\tcarried\tmoving_now\t"
+         "moving\n";
 }
 
 std::string objectLogLines(double stamp_s, const MotionDiagnostics& d, const ClassTable& classes) {
   std::string out;
   for (const auto& o : d.objects) {
     const auto& b = o.detection.box;
-    char line[256];
-    std::snprintf(
-        line, sizeof(line),
-        "%.6f\t%s\t%.2f\t%.0f\t%.0f\t%.0f\t%.0f\t%.2f\t%d\t%d\t%d\t%.2f\t%.3f\t%d\t%d\t%d\t%d\n",
-        stamp_s, classes.name(o.detection.class_id).c_str(), o.detection.score, b.x, b.y, b.width,
-        b.height, o.depth_m, o.points, o.dynamic_points, o.anchor.points, o.anchor.median_px,
-        o.anchor.median_dz_m, o.quiet_frames, o.carried ? 1 : 0, o.moving_now ? 1 : 0,
-        o.moving ? 1 : 0);
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  "%.6f\t%s\t%.2f\t%.0f\t%.0f\t%.0f\t%.0f\t%.2f\t%d\t%d\t%d\t%.2f\t%.3f\t"
+                  "%d\t%.3f\t%d\t%d\t%d\t%d\n",
+                  stamp_s, classes.name(o.detection.class_id).c_str(), o.detection.score, b.x, b.y,
+                  b.width, b.height, o.depth_m, o.points, o.dynamic_points, o.anchor.points,
+                  o.anchor.median_px, o.anchor.median_dz_m, o.anchor.surface_points,
+                  o.anchor.surface_dz_m, o.quiet_frames, o.carried ? 1 : 0, o.moving_now ? 1 : 0,
+                  o.moving ? 1 : 0);
     out += line;
   }
   return out;

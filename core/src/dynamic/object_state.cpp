@@ -9,8 +9,9 @@ namespace dynamap {
 
 namespace {
 
-constexpr int kStaticMinPoints = 5;   ///< points needed on an object to call it static now
-constexpr int kMaxSlowDoublings = 4;  ///< ObjectTrack::slow_moves: at most 16 x the frames
+constexpr int kStaticMinPoints = 5;    ///< points needed on an object to call it static now
+constexpr int kMaxSlowDoublings = 4;   ///< ObjectTrack::slow_moves: at most 16 x the frames
+constexpr int kSurfaceMinPoints = 30;  ///< surface points needed to judge an object by them
 
 /// What an object's own points, followed over time, say in this frame: against the pose from
 /// landmarks proven static they are within the pose noise (still), clearly off (twice that) or
@@ -53,21 +54,44 @@ double stillLimitPx(const ObjectDecision& d, const cv::Vec4d& K, const DynamicCo
   return c.static_anchor_px > 0.0 ? std::max(c.static_anchor_px, sway_px) : 0.0;
 }
 
+/// Enough of its surface of kSurfaceBaselineFrames back lands on the object now to judge it.
+bool surfaceJudged(const ObjectDecision& d, const DynamicConfig& c) {
+  return c.static_surface_m > 0.0 && d.anchor.surface_points >= kSurfaceMinPoints;
+}
+
 /// Its anchors are off by twice the still limit, and by more than the sensor's depth noise
 /// could make them (3 sigma of the difference of two depths): a wall 4 m away is no mover.
 bool movedBeyondNoise(const ObjectDecision& d, const cv::Vec4d& K, const DynamicConfig& c) {
   const double noise_z = 3.0 * std::sqrt(2.0) * depthNoiseM(d.depth_m);
   return d.anchor.median_px > 2.0 * stillLimitPx(d, K, c) ||
-         std::abs(d.anchor.median_dz_m) > 2.0 * std::max(c.static_anchor_depth_m, noise_z);
+         std::abs(d.anchor.median_dz_m) > 2.0 * std::max(c.static_anchor_depth_m, noise_z) ||
+         (surfaceJudged(d, c) && std::abs(d.anchor.surface_dz_m) > 2.0 * c.static_surface_m);
 }
 
+/// The verdict of one measure against its still limit `tau` (beyond twice it: moved).
+AnchorVerdict againstLimit(double off, double tau) {
+  if (off <= tau) return AnchorVerdict::kStill;
+  return off > 2.0 * tau ? AnchorVerdict::kMoved : AnchorVerdict::kUndecided;
+}
+
+/// The worse of what its anchored points and its surface say (either may say nothing).
 AnchorVerdict judgeAnchors(const ObjectDecision& d, const ObjectTrack* prev, const cv::Vec4d& K,
                            const DynamicConfig& c) {
+  AnchorVerdict verdict = AnchorVerdict::kNone;
   const double tau = stillLimitPx(d, K, c);
-  if (!(tau > 0.0 && d.anchor.points >= kAnchorMinPoints)) return AnchorVerdict::kNone;
-  const double tau_z = c.static_anchor_depth_m, dz = std::abs(d.anchor.median_dz_m);
-  if (d.anchor.median_px <= tau && dz <= tau_z) return AnchorVerdict::kStill;
-  if (!(d.anchor.median_px > 2.0 * tau || dz > 2.0 * tau_z)) return AnchorVerdict::kUndecided;
+  if (tau > 0.0 && d.anchor.points >= kAnchorMinPoints) {
+    verdict = std::max(againstLimit(d.anchor.median_px, tau),
+                       againstLimit(std::abs(d.anchor.median_dz_m), c.static_anchor_depth_m));
+  }
+  // The surface only adds motion: alone it calls nothing still (an object with too few anchored
+  // points to judge is judged by its centroid, which a walker drifts out of).
+  if (surfaceJudged(d, c)) {
+    const AnchorVerdict surface = againstLimit(std::abs(d.anchor.surface_dz_m), c.static_surface_m);
+    if (verdict != AnchorVerdict::kNone || surface != AnchorVerdict::kStill) {
+      verdict = std::max(verdict, surface);
+    }
+  }
+  if (verdict != AnchorVerdict::kMoved) return verdict;
   const bool held = c.static_anchor_move_frames > 1 && countedStill(prev, c) && prev->anchors_still;
   return held ? AnchorVerdict::kJumpHeld : AnchorVerdict::kMoved;
 }
@@ -100,6 +124,12 @@ ObjectTrack startTrack(const ObjectDecision& d, const ObjectTrack* prev, const O
                       std::abs(d.depth_m - prev->depth_m) >= c.depth_band_m;
   const bool slow_move = obs.anchors == AnchorVerdict::kMoved && !obs.flagged && !jumped;
   t.slow_moves = (prev != nullptr && !jumped ? prev->slow_moves : 0) + (slow_move ? 1 : 0);
+  // Its surfaces of the last frames: a depth cut that jumped starts them over.
+  if (prev != nullptr && !jumped) t.surfaces = prev->surfaces;
+  if (d.anchor.surface_fresh && !d.anchor.surface_fresh->empty()) {
+    t.surfaces.push_back(d.anchor.surface_fresh);
+  }
+  while (t.surfaces.size() > kSurfaceBaselineFrames) t.surfaces.pop_front();
   return t;
 }
 

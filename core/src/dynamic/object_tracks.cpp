@@ -1,6 +1,9 @@
 #include "dynamap/core/dynamic/object_tracks.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include "dynamap/core/dynamic/depth_check.hpp"
 
 namespace dynamap {
 namespace {
@@ -54,6 +57,50 @@ AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
     out.median_dz_m = *mid_z;
   }
   return out;
+}
+
+std::vector<cv::Vec3f> sampleSurface(const cv::Mat& region, const cv::Mat& depth_m,
+                                     const cv::Matx44d& T_W_C, const cv::Vec4d& K, int stride_px) {
+  std::vector<cv::Vec3f> out;
+  if (region.empty() || region.size() != depth_m.size()) return out;
+  const int step = std::max(1, stride_px);
+  for (int v = step / 2; v < region.rows; v += step) {
+    const std::uint8_t* in = region.ptr<std::uint8_t>(v);
+    for (int u = step / 2; u < region.cols; u += step) {
+      if (in[u] == 0) continue;
+      const double z = interiorDepth(depth_m, u, v);
+      if (!(z > 0.0)) continue;
+      const cv::Vec4d p = T_W_C * cv::Vec4d((u - K[2]) / K[0] * z, (v - K[3]) / K[1] * z, z, 1.0);
+      out.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]),
+                       static_cast<float>(p[2]));
+    }
+  }
+  return out;
+}
+
+void checkSurface(const std::vector<cv::Vec3f>& surface_W, const cv::Mat& region,
+                  const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
+                  double max_dz_m, AnchorCheck* out) {
+  out->surface_points = 0;
+  out->surface_dz_m = 0.0;
+  if (surface_W.empty() || region.empty() || region.size() != depth_m.size()) return;
+  const cv::Matx44d T_C_W = T_W_C.inv(cv::DECOMP_SVD);
+  std::vector<double> dz;
+  dz.reserve(surface_W.size());
+  for (const cv::Vec3f& p : surface_W) {
+    const cv::Vec4d q = T_C_W * cv::Vec4d(p[0], p[1], p[2], 1.0);
+    if (q[2] <= 0.1) continue;
+    const int u = cvRound(K[0] * q[0] / q[2] + K[2]), v = cvRound(K[1] * q[1] / q[2] + K[3]);
+    if (u < 0 || v < 0 || u >= region.cols || v >= region.rows) continue;
+    if (region.at<std::uint8_t>(v, u) == 0) continue;
+    const double z = interiorDepth(depth_m, u, v);
+    if (z > 0.0 && std::abs(z - q[2]) <= max_dz_m) dz.push_back(z - q[2]);
+  }
+  if (dz.empty()) return;
+  const auto mid = dz.begin() + static_cast<std::ptrdiff_t>(dz.size() / 2);
+  std::nth_element(dz.begin(), mid, dz.end());
+  out->surface_points = static_cast<int>(dz.size());
+  out->surface_dz_m = *mid;
 }
 
 bool medianFlowIn(const cv::Rect2f& box, const std::vector<cv::Point2f>& prev_px,

@@ -79,6 +79,20 @@ void countPointsOn(const cv::Mat& region, const cv::Mat& depth_m,
   }
 }
 
+/// The object's surface sampled now, and checked against the one kSurfaceBaselineFrames back
+/// (prev's) into d.anchor.
+void checkSurfaceOf(const cv::Mat& region, const cv::Mat& depth_m, const FusionEvidence& evidence,
+                    const ObjectTrack* prev, ObjectDecision& d) {
+  constexpr int kSurfaceStridePx = 8;
+  constexpr double kSurfaceMaxDzM = 0.15;  ///< farther off is another surface (an occluder)
+  d.anchor.surface_fresh = std::make_shared<const std::vector<cv::Vec3f>>(
+      sampleSurface(region, depth_m, evidence.T_W_C, evidence.K, kSurfaceStridePx));
+  if (prev != nullptr && prev->surfaces.size() >= kSurfaceBaselineFrames) {
+    checkSurface(*prev->surfaces.front(), region, depth_m, evidence.T_W_C, evidence.K,
+                 kSurfaceMaxDzM, &d.anchor);
+  }
+}
+
 /// FusionEvidence::point_ids of the points inside `region` (empty without ids).
 std::vector<std::uint64_t> idsIn(const cv::Mat& region, const std::vector<cv::Point2f>& points,
                                  const FusionEvidence& evidence) {
@@ -168,6 +182,11 @@ cv::Mat RegionFusion::objectRegion(const Frame& f, const cv::Rect& box, ObjectDe
     d.has_position = true;
   }
   countPointsOn(region, f.depth_m, f.points, f.dyn, f.evidence, prev, d);
+  // People sway on the spot; a pushed chair or box moves and stops, judged by its anchors.
+  if (config_.static_surface_m > 0.0 && f.evidence.has_pose &&
+      classes_.isDetectedHighDynamic(d.detection.class_id)) {
+    checkSurfaceOf(region, f.depth_m, f.evidence, prev, d);
+  }
   return region;
 }
 
@@ -212,7 +231,7 @@ void RegionFusion::rememberEndedStill(const std::vector<bool>& matched, const cv
     const bool ended = !(t < matched.size() && matched[t]) && !carried(t, image);
     if (ended && !track.moving && track.slow_moves == 0 &&
         track.quiet_frames >= kRememberQuietFactor * config_.static_confirm_frames &&
-        classes_.isHighDynamic(track.class_id) && track.class_id != ClassTable::kMover &&
+        classes_.isDetectedHighDynamic(track.class_id) &&
         static_cast<int>(track.anchors.size()) >= kAnchorMinPoints) {
       remembered_.push_back(track);
       remembered_until_.push_back(frame_ + config_.remember_still_frames);
@@ -251,7 +270,7 @@ bool RegionFusion::underPerson(const Detection& object,
   if (classes_.isHighDynamic(object.class_id)) return false;
   const float area = object.box.area();
   const auto covers = [&](int class_id, const cv::Rect2f& box) {
-    return classes_.isHighDynamic(class_id) && class_id != ClassTable::kMover && area > 0.f &&
+    return classes_.isDetectedHighDynamic(class_id) && area > 0.f &&
            (box & object.box).area() >= kUnderPersonShare * area;
   };
   for (const auto& o : detections)

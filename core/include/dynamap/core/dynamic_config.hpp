@@ -66,7 +66,7 @@ struct DynamicConfig {
   /// detector still overlaps tracking; false = the newest finished detections, frames arriving
   /// while the detector is busy are skipped (`--realtime` sets false).
   bool detector_lockstep = true;
-  int detector_max_age_frames = 6;   ///< older detections are not used (async)
+  int detector_max_age_frames = 6;  ///< older detections are not used (async)
   /// Lockstep runs: only every Nth frame goes to the detector (the first always); the frames
   /// between use the newest detections, their boxes moved by the flow inside them and grown
   /// by stale_box_growth_px per frame of age. 1 = every frame.
@@ -109,6 +109,13 @@ struct DynamicConfig {
   /// ... and their signed median depth difference within this (m): a sway along the line of
   /// sight. Twice either threshold is motion: the count of quiet frames starts over.
   double static_anchor_depth_m = 0.03;
+  /// ... and the signed median depth change of its whole surface since kSurfaceBaselineFrames
+  /// (12) frames back (its pixels sampled then, seen now: hundreds of depths) within this (m;
+  /// 0 = not checked); twice it is motion. A person swaying a few centimetres along the line of
+  /// sight 3 m away moves a dozen edge features within their depth noise, but the median of his
+  /// surface beyond it; a still one keeps it within a few millimetres. It only adds motion: alone
+  /// (too few anchored points) it calls nothing still.
+  double static_surface_m = 0.015;
   /// For a person already confirmed still: frames in a row his anchors must be off by twice the
   /// limit before the count starts over (1 = the first one). Masked (held) in those frames.
   int static_anchor_move_frames = 2;

@@ -25,6 +25,11 @@ class ClassTable {
   std::size_t size() const { return weights_.size(); }  ///< COCO's 80 and kMover
   const std::string& name(int class_id) const;
   bool isHighDynamic(int class_id) const;
+  /// A high-dynamic class the detector reports (a person, an animal: it moves by itself, and may
+  /// sway or step on the spot), not a mover that geometry found.
+  bool isDetectedHighDynamic(int class_id) const {
+    return class_id != kMover && isHighDynamic(class_id);
+  }
   /// Motion prior in [0, 1]; 0 for an out-of-range id.
   double weight(int class_id) const;
   /// Score threshold the detector applies to this class.

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -36,6 +38,13 @@ struct AnchorCheck {
   double median_dz_m = 0.0;
   std::vector<PointAnchor> kept;   ///< earlier anchors seen now, plus the new points anchored
   std::vector<PointAnchor> fresh;  ///< every point seen now, anchored where it is now
+  /// The same for the object's whole surface (checkSurface()): its points sampled
+  /// kSurfaceBaselineFrames back that land on its pixels now, and their signed median depth
+  /// change (m). Hundreds of depths, not a dozen features on edges: a sway along the line of
+  /// sight of 2 cm at 3 m.
+  int surface_points = 0;
+  double surface_dz_m = 0.0;
+  std::shared_ptr<const std::vector<cv::Vec3f>> surface_fresh;  ///< its surface sampled now (world)
 };
 
 /// Checks `now` against `anchors` (sorted by id) with camera pose T_W_C (camera -> world) and
@@ -43,6 +52,24 @@ struct AnchorCheck {
 AnchorCheck checkAnchors(const std::vector<PointAnchor>& anchors,
                          const std::vector<PointSample>& now, const cv::Matx44d& T_W_C,
                          const cv::Vec4d& K);
+
+/// How far back (frames with a pose) an object's surface is compared with: 0.4 s at 30 Hz, a
+/// quarter to a half of a sway's period, while the camera turns a few degrees at most (the parts
+/// of a round object that it hid or showed meanwhile stay few).
+constexpr int kSurfaceBaselineFrames = 12;
+
+/// Every `stride_px`-th pixel (both ways) of `region` (CV_8UC1, 255 = in) off depth edges, as a
+/// world point (camera pose T_W_C, intrinsics K = fx, fy, cx, cy).
+std::vector<cv::Vec3f> sampleSurface(const cv::Mat& region, const cv::Mat& depth_m,
+                                     const cv::Matx44d& T_W_C, const cv::Vec4d& K, int stride_px);
+
+/// Projects `surface_W` (an object's surface some frames back) into the current frame: the
+/// points landing on `region` with depth there within `max_dz_m` (else another surface: an
+/// occluder, the floor) give out->surface_points and the signed median of (depth now - point's
+/// depth) in out->surface_dz_m.
+void checkSurface(const std::vector<cv::Vec3f>& surface_W, const cv::Mat& region,
+                  const cv::Mat& depth_m, const cv::Matx44d& T_W_C, const cv::Vec4d& K,
+                  double max_dz_m, AnchorCheck* out);
 
 /// The temporal state of one detected object, carried from frame to frame by RegionFusion.
 struct ObjectTrack {
@@ -55,6 +82,10 @@ struct ObjectTrack {
   bool has_anchor = false;
   cv::Vec3d anchor_W;                ///< world position where its current run of quiet frames began
   std::vector<PointAnchor> anchors;  ///< its points' world positions since that run began
+  /// Its surface sampled in the last frames with a pose (world; oldest first), at most
+  /// kSurfaceBaselineFrames: the oldest is what checkSurface() compares with.
+  /// Shared, never changed: tracks copied from frame to frame copy pointers only.
+  std::deque<std::shared_ptr<const std::vector<cv::Vec3f>>> surfaces;
   /// Times its anchors showed motion that no frame-to-frame check saw (a sway, a slow step):
   /// each doubles the quiet frames it needs to be kept (at most 16 x).
   int slow_moves = 0;
