@@ -250,7 +250,8 @@ std::vector<std::uint64_t> LocalMap::newestKeyframes(int count) const {
   std::vector<std::uint64_t> newest;
   const int n = static_cast<int>(keyframes_.size());
   for (int k = n - 1; k >= std::max(0, n - count); --k) {
-    if (!keyframes_[static_cast<std::size_t>(k)].culled) newest.push_back(static_cast<std::uint64_t>(k));
+    if (!keyframes_[static_cast<std::size_t>(k)].culled)
+      newest.push_back(static_cast<std::uint64_t>(k));
   }
   return newest;
 }
@@ -326,6 +327,9 @@ MapContents LocalMap::contents() const {
 
 void LocalMap::restore(MapContents contents) {
   for (auto& kf : contents.keyframes) kf.loaded = true;
+  // A saved map proves nothing static now (a chair may have moved since): its landmarks count
+  // towards the pose from proven-static landmarks once this run's keyframes see them.
+  for (auto& lm : contents.landmarks) lm.keyframes = 0;
   std::lock_guard<std::mutex> lock(mutex_);
   landmarks_ = std::move(contents.landmarks);
   keyframes_ = std::move(contents.keyframes);

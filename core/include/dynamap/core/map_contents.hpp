@@ -13,7 +13,8 @@ struct Landmark {
   Eigen::Vector3d p_W;
   cv::Mat descriptor;  ///< 1 x 32 CV_8U
   bool bad = false;    ///< seen on a moving object: never used again
-  int keyframes = 0;   ///< keyframes that observed it
+  /// Keyframes of this run that observed it (LocalMap::restore() starts a saved map's at 0).
+  int keyframes = 0;
 };
 
 struct KeyframeObservation {
