@@ -16,8 +16,11 @@ endforeach()
 add_test(NAME real_data.band_logic COMMAND /usr/bin/python3 -m pytest -q
          ${CMAKE_CURRENT_LIST_DIR}/test_bands.py)
 set_tests_properties(real_data.band_logic PROPERTIES LABELS unit)
-# Save and reload on real data (issue 47's criterion): run 2, teddy played backward in run 1's map.
-add_test(NAME real_data.reload_teddy
-         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/reload_check.py teddy
-                 --dynamap $<TARGET_FILE:dynamap> --work ${PROJECT_BINARY_DIR}/real_data_reload)
-set_tests_properties(real_data.reload_teddy PROPERTIES LABELS real_data TIMEOUT 600 COST 60)
+# Save and reload on real data (issue 47's criterion): run 2 plays the sequence backward in
+# run 1's map.
+foreach(case teddy bonn_crowd_slice)
+  add_test(NAME real_data.reload_${case}
+           COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/reload_check.py ${case}
+                   --dynamap $<TARGET_FILE:dynamap> --work ${PROJECT_BINARY_DIR}/real_data_reload)
+  set_tests_properties(real_data.reload_${case} PROPERTIES LABELS real_data TIMEOUT 600 COST 60)
+endforeach()

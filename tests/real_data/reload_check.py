@@ -4,14 +4,17 @@ the sequence backward in that map. Fails unless run 2 relocalizes within its fir
 its trajectory, moved into the ground truth's frame by run 1's ATE alignment (no alignment of
 its own), has an ATE of at most 2 cm, and it adds at most 10 % new keyframes.
 
-  reload_check.py CASE --dynamap BIN [--work DIR]      CASE: teddy
+  reload_check.py CASE --dynamap BIN [--work DIR]      CASE: teddy, bonn_crowd_slice
 """
 import argparse, json, os, shutil, subprocess, sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SHARED = os.path.normpath(os.path.join(HERE, "..", "..", "..", "shared"))
-# name: sequence under ../shared/data, its last frame (run 2 plays it from there to 0)
-CASES = {"teddy": ("tum/rgbd_dataset_freiburg3_teddy", 199)}
+from bands import SHARED, SOURCE
+
+# name: sequence under ../shared/data, its last frame (run 2 plays it from there to 0), config
+CASES = {
+    "teddy": ("tum/rgbd_dataset_freiburg3_teddy", 199, None),
+    "bonn_crowd_slice": ("bonn/rgbd_bonn_crowd_400_499", 99, "config/bonn.yaml"),
+}
 MAX_RELOCALIZED_FRAME = 10
 MAX_ATE_CM = 2.0
 MAX_NEW_KEYFRAME_SHARE = 0.10
@@ -41,7 +44,8 @@ def main():
     ap.add_argument("--dynamap", required=True)
     ap.add_argument("--work", default="/tmp/dynamap_reload_check")
     a = ap.parse_args()
-    source, last = CASES[a.case]
+    source, last, config = CASES[a.case]
+    extra = ["--config", os.path.join(SOURCE, config)] if config else []
     seq = os.path.join(SHARED, "data", source)
     if not os.path.isdir(seq):
         sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
@@ -50,12 +54,14 @@ def main():
     os.makedirs(work)
     back, saved, align = (os.path.join(work, n) for n in ("backward", "map", "alignment.txt"))
     run1, run2 = os.path.join(work, "run1"), os.path.join(work, "run2")
-    run([a.dynamap, "run", "--sequence", seq, "--out", run1, "--quiet", "--save-map", saved])
+    run([a.dynamap, "run", "--sequence", seq, "--out", run1, "--quiet", "--save-map", saved]
+        + extra)
     run([a.dynamap, "evaluate", "--gt", os.path.join(seq, "groundtruth.txt"), "--est",
          os.path.join(run1, "trajectory.txt"), "--save-alignment", align])
     run(["/usr/bin/python3", os.path.join(SHARED, "tools", "make_long.py"), seq, back,
          "%d,0" % last])
-    run([a.dynamap, "run", "--sequence", back, "--out", run2, "--quiet", "--load-map", saved])
+    run([a.dynamap, "run", "--sequence", back, "--out", run2, "--quiet", "--load-map", saved]
+        + extra)
     ate = json.loads(run([a.dynamap, "evaluate", "--gt", os.path.join(back, "groundtruth.txt"),
                           "--est", os.path.join(run2, "trajectory.txt"), "--alignment", align,
                           "--json"]))["ate"]["rmse_m"] * 100.0

@@ -228,6 +228,21 @@ void Tracker::Impl::cullRemainingRedundantKeyframes() {
   }
 }
 
+// The map covers the view if the frame then tracks kf_min_tracked_ratio of
+// min_tracked_features points, and RANSAC keeps twice min_inliers of them. In a frame the movers
+// fill (kf_max_masked_share) the static view holds fewer: as many as a keyframe is made for
+// there (kf_crowded_min_tracks), else a revisit in a crowd makes the keyframe it was to spare
+// (the Bonn slice played backward in its saved map: 58 and 49 of the old landmarks found
+// again, 60 needed, 2 new keyframes for 15).
+double Tracker::Impl::revisitMinTracks(const cv::Mat& movers) const {
+  const double needed =
+      config_.kf_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
+  if (config_.kf_crowded_min_tracks <= 0 || maskedShare(movers) <= config_.kf_max_masked_share) {
+    return needed;
+  }
+  return std::min(needed, static_cast<double>(config_.kf_crowded_min_tracks));
+}
+
 bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
                                   const cv::Mat& track_mask, const cv::Mat& movers,
                                   Eigen::Isometry3d& T_W_C, int& inliers) {
@@ -246,10 +261,7 @@ bool Tracker::Impl::reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray,
 
   const std::vector<FeatureTrack> saved = tracks_;
   mergeTracks(findMapLandmarks(frame, gray, track_mask, T_W_C, sources));
-  // The map covers the view if the frame then tracks kf_min_tracked_ratio of
-  // min_tracked_features points, and RANSAC keeps twice min_inliers of them.
-  const double needed =
-      config_.kf_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
+  const double needed = revisitMinTracks(movers);
   Eigen::Isometry3d T = T_W_C;
   int n = 0;
   if (static_cast<double>(tracks_.size()) < needed || !estimatePose(frame, T, n) ||

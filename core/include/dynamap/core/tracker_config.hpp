@@ -88,7 +88,8 @@ struct TrackerConfig {
   /// Revisits: when a keyframe is due, the nearest keyframe within this share of the
   /// translation and rotation limits above becomes the reference again if the frame, with the
   /// landmarks of the keyframes near it found again, tracks kf_min_tracked_ratio x
-  /// min_tracked_features points (2 x min_inliers after RANSAC), instead of a new keyframe with
+  /// min_tracked_features points (kf_crowded_min_tracks in a frame beyond kf_max_masked_share;
+  /// 2 x min_inliers after RANSAC), instead of a new keyframe with
   /// new landmarks beside the old ones: keyframes grow with the space explored, not with time
   /// (0 = off).
   double kf_reuse_distance = 0.5;

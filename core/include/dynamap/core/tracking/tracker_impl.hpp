@@ -122,6 +122,8 @@ class Tracker::Impl {
   /// frame tracks its landmarks (pose refined with them); false (nothing changed) if none does.
   bool reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
                      const cv::Mat& movers, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The tracks a revisit needs with the old landmarks found again (reuseKeyframe()).
+  double revisitMinTracks(const cv::Mat& movers) const;
   /// The keyframes a revisit at T_W_C is judged and tracked against: the nearest 8 within the
   /// keyframe limits.
   std::vector<std::uint64_t> reuseSources(const Eigen::Isometry3d& T_W_C) const;
