@@ -4,16 +4,22 @@ the sequence backward in that map. Fails unless run 2 relocalizes within its fir
 its trajectory, moved into the ground truth's frame by run 1's ATE alignment (no alignment of
 its own), has an ATE of at most 2 cm, and it adds at most 10 % new keyframes.
 
-  reload_check.py CASE --dynamap BIN [--work DIR]      CASE: teddy, bonn_crowd_slice
+  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...]
+
+--frames: run 1 plays frames FIRST..LAST of the case, run 2 LAST..FIRST (both made by
+../shared/tools/make_long.py); repeat it to check several spans, one line each. Default: the
+whole sequence. Exit status 1 if any span fails.
 """
 import argparse, json, os, shutil, subprocess, sys
 
 from bands import SHARED, SOURCE
 
-# name: sequence under ../shared/data, its last frame (run 2 plays it from there to 0), config
+# name: sequence under ../shared/data, its last frame, config
 CASES = {
     "teddy": ("tum/rgbd_dataset_freiburg3_teddy", 199, None),
     "bonn_crowd_slice": ("bonn/rgbd_bonn_crowd_400_499", 99, "config/bonn.yaml"),
+    "teddy_dyn_dev": ("dynamic/teddy_dyn_dev", 199, None),
+    "teddy_dyn_crowd_dev": ("dynamic/teddy_dyn_crowd_dev", 199, None),
 }
 MAX_RELOCALIZED_FRAME = 10
 MAX_ATE_CM = 2.0
@@ -38,42 +44,69 @@ def first_posed_frame(out):
     return next((i for i, s in enumerate(states) if s in ("tracked", "relocalized")), None)
 
 
+def played(seq, first, last, out):
+    """The frames first..last of seq, played by make_long.py into out."""
+    run(["/usr/bin/python3", os.path.join(SHARED, "tools", "make_long.py"), seq, out,
+         "%d,%d" % (first, last)])
+    return out
+
+
+def check_span(dynamap, case, first, last, work):
+    """Runs 1 and 2 over one span; returns (passed, the line to print)."""
+    source, case_last, config = CASES[case]
+    extra = ["--config", os.path.join(SOURCE, config)] if config else []
+    seq = os.path.join(SHARED, "data", source)
+    if not os.path.isdir(seq):
+        sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    saved, align = os.path.join(work, "map"), os.path.join(work, "alignment.txt")
+    run1, run2 = os.path.join(work, "run1"), os.path.join(work, "run2")
+    forward = seq if (first, last) == (0, case_last) else played(
+        seq, first, last, os.path.join(work, "forward"))
+    back = played(seq, last, first, os.path.join(work, "backward"))
+    run([dynamap, "run", "--sequence", forward, "--out", run1, "--quiet", "--save-map", saved]
+        + extra)
+    run([dynamap, "evaluate", "--gt", os.path.join(forward, "groundtruth.txt"), "--est",
+         os.path.join(run1, "trajectory.txt"), "--save-alignment", align])
+    run([dynamap, "run", "--sequence", back, "--out", run2, "--quiet", "--load-map", saved]
+        + extra)
+    ate = json.loads(run([dynamap, "evaluate", "--gt", os.path.join(back, "groundtruth.txt"),
+                          "--est", os.path.join(run2, "trajectory.txt"), "--alignment", align,
+                          "--json"]))["ate"]["rmse_m"] * 100.0
+    loaded, new = counts(run1)["keyframes"], counts(run2)["keyframes"]
+    posed = first_posed_frame(run2)
+    ok = (posed is not None and posed <= MAX_RELOCALIZED_FRAME and ate <= MAX_ATE_CM
+          and new <= MAX_NEW_KEYFRAME_SHARE * loaded)
+    line = ("%s %d-%d: run 2 first posed at frame %s (<= %d), ATE %.2f cm with run 1's "
+            "alignment (<= %.1f), %d new keyframes of %d (<= %.0f %%)%s"
+            % (case, first, last, posed, MAX_RELOCALIZED_FRAME, ate, MAX_ATE_CM, new, loaded,
+               100 * MAX_NEW_KEYFRAME_SHARE, "" if ok else "  FAILED"))
+    return ok, line
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("case", choices=sorted(CASES))
     ap.add_argument("--dynamap", required=True)
     ap.add_argument("--work", default="/tmp/dynamap_reload_check")
+    ap.add_argument("--frames", action="append", default=[], metavar="FIRST,LAST")
     a = ap.parse_args()
-    source, last, config = CASES[a.case]
-    extra = ["--config", os.path.join(SOURCE, config)] if config else []
-    seq = os.path.join(SHARED, "data", source)
-    if not os.path.isdir(seq):
-        sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
-    work = os.path.join(a.work, a.case)
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
-    back, saved, align = (os.path.join(work, n) for n in ("backward", "map", "alignment.txt"))
-    run1, run2 = os.path.join(work, "run1"), os.path.join(work, "run2")
-    run([a.dynamap, "run", "--sequence", seq, "--out", run1, "--quiet", "--save-map", saved]
-        + extra)
-    run([a.dynamap, "evaluate", "--gt", os.path.join(seq, "groundtruth.txt"), "--est",
-         os.path.join(run1, "trajectory.txt"), "--save-alignment", align])
-    run(["/usr/bin/python3", os.path.join(SHARED, "tools", "make_long.py"), seq, back,
-         "%d,0" % last])
-    run([a.dynamap, "run", "--sequence", back, "--out", run2, "--quiet", "--load-map", saved]
-        + extra)
-    ate = json.loads(run([a.dynamap, "evaluate", "--gt", os.path.join(back, "groundtruth.txt"),
-                          "--est", os.path.join(run2, "trajectory.txt"), "--alignment", align,
-                          "--json"]))["ate"]["rmse_m"] * 100.0
-    loaded, new = counts(run1)["keyframes"], counts(run2)["keyframes"]
-    first = first_posed_frame(run2)
-    print("%s: run 2 first posed at frame %s (<= %d), ATE %.2f cm with run 1's alignment "
-          "(<= %.1f), %d new keyframes of %d (<= %.0f %%)"
-          % (a.case, first, MAX_RELOCALIZED_FRAME, ate, MAX_ATE_CM, new, loaded,
-             100 * MAX_NEW_KEYFRAME_SHARE))
-    ok = (first is not None and first <= MAX_RELOCALIZED_FRAME and ate <= MAX_ATE_CM
-          and new <= MAX_NEW_KEYFRAME_SHARE * loaded)
-    return 0 if ok else 1
+    last = CASES[a.case][1]
+    try:
+        spans = [tuple(int(v) for v in f.split(",")) for f in a.frames] or [(0, last)]
+    except ValueError:
+        ap.error("--frames takes FIRST,LAST (frame numbers): %s" % a.frames)
+    for span in spans:
+        if len(span) != 2 or not 0 <= span[0] < span[1] <= last:
+            ap.error("--frames %s: need FIRST,LAST with 0 <= FIRST < LAST <= %d" % (span, last))
+    failed = 0
+    for first, last in spans:
+        ok, line = check_span(a.dynamap, a.case, first, last,
+                              os.path.join(a.work, "%s_%d_%d" % (a.case, first, last)))
+        print(line, flush=True)
+        failed += not ok
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
