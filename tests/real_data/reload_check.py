@@ -4,11 +4,12 @@ the sequence backward in that map. Fails unless run 2 relocalizes within its fir
 its trajectory, moved into the ground truth's frame by run 1's ATE alignment (no alignment of
 its own), has an ATE of at most 2 cm, and it adds at most 10 % new keyframes.
 
-  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...]
+  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...] [--set KEY=VALUE ...]
 
 --frames: run 1 plays frames FIRST..LAST of the case, run 2 LAST..FIRST (both made by
 ../shared/tools/make_long.py); repeat it to check several spans, one line each. Default: the
-whole sequence. Exit status 1 if any span fails.
+whole sequence. --set: passed to both runs (`dynamap run --set`). Exit status 1 if any span
+fails.
 """
 import argparse, json, os, shutil, subprocess, sys
 
@@ -51,10 +52,12 @@ def played(seq, first, last, out):
     return out
 
 
-def check_span(dynamap, case, first, last, work):
+def check_span(dynamap, case, first, last, work, sets):
     """Runs 1 and 2 over one span; returns (passed, the line to print)."""
     source, case_last, config = CASES[case]
     extra = ["--config", os.path.join(SOURCE, config)] if config else []
+    for kv in sets:
+        extra += ["--set", kv]
     seq = os.path.join(SHARED, "data", source)
     if not os.path.isdir(seq):
         sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
@@ -91,6 +94,7 @@ def main():
     ap.add_argument("--dynamap", required=True)
     ap.add_argument("--work", default="/tmp/dynamap_reload_check")
     ap.add_argument("--frames", action="append", default=[], metavar="FIRST,LAST")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
     last = CASES[a.case][1]
     try:
@@ -103,7 +107,7 @@ def main():
     failed = 0
     for first, last in spans:
         ok, line = check_span(a.dynamap, a.case, first, last,
-                              os.path.join(a.work, "%s_%d_%d" % (a.case, first, last)))
+                              os.path.join(a.work, "%s_%d_%d" % (a.case, first, last)), a.set)
         print(line, flush=True)
         failed += not ok
     return 1 if failed else 0
