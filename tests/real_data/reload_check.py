@@ -13,15 +13,11 @@ fails.
 """
 import argparse, json, os, shutil, subprocess, sys
 
+import bands
 from bands import SHARED, SOURCE
 
-# name: sequence under ../shared/data, its last frame, config
-CASES = {
-    "teddy": ("tum/rgbd_dataset_freiburg3_teddy", 199, None),
-    "bonn_crowd_slice": ("bonn/rgbd_bonn_crowd_400_499", 99, "config/bonn.yaml"),
-    "teddy_dyn_dev": ("dynamic/teddy_dyn_dev", 199, None),
-    "teddy_dyn_crowd_dev": ("dynamic/teddy_dyn_crowd_dev", 199, None),
-}
+# name (a case of bands.py, as it is): its last frame (run 2 plays the sequence from there)
+CASES = {"teddy": 199, "bonn_crowd_slice": 99, "teddy_dyn_dev": 199, "teddy_dyn_crowd_dev": 199}
 MAX_RELOCALIZED_FRAME = 10
 MAX_ATE_CM = 2.0
 MAX_NEW_KEYFRAME_SHARE = 0.10
@@ -54,7 +50,8 @@ def played(seq, first, last, out):
 
 def check_span(dynamap, case, first, last, work, sets):
     """Runs 1 and 2 over one span; returns (passed, the line to print)."""
-    source, case_last, config = CASES[case]
+    source, _, config = bands.CASES[case]
+    case_last = CASES[case]
     extra = ["--config", os.path.join(SOURCE, config)] if config else []
     for kv in sets:
         extra += ["--set", kv]
@@ -96,7 +93,7 @@ def main():
     ap.add_argument("--frames", action="append", default=[], metavar="FIRST,LAST")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
-    last = CASES[a.case][1]
+    last = CASES[a.case]
     try:
         spans = [tuple(int(v) for v in f.split(",")) for f in a.frames] or [(0, last)]
     except ValueError:

@@ -117,7 +117,7 @@ bool Tracker::Impl::needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_
     // Few tracks in a frame the movers fill mean nothing new to map: what is left unmasked is
     // little and near the movers, and the tracks come back when they leave. Unless they are
     // about to run out: then the pose needs the landmarks of what is left.
-    if (maskedShare(movers) <= config_.kf_max_masked_share) return true;
+    if (!crowdedView(movers)) return true;
     if (n < config_.kf_crowded_min_tracks) return true;
   }
   const Eigen::Isometry3d T_ref_C = ref_T_W_C_.inverse() * T_W_C;

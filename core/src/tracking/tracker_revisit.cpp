@@ -61,6 +61,10 @@ double maskedShare(const cv::Mat& mask) {
   return mask.empty() ? 0.0 : cv::countNonZero(mask) / static_cast<double>(mask.total());
 }
 
+bool Tracker::Impl::crowdedView(const cv::Mat& movers) const {
+  return maskedShare(movers) > config_.kf_max_masked_share;
+}
+
 std::vector<std::uint64_t> Tracker::Impl::trackedLandmarks() const {
   std::vector<std::uint64_t> ids;
   ids.reserve(tracks_.size());
@@ -237,9 +241,7 @@ void Tracker::Impl::cullRemainingRedundantKeyframes() {
 double Tracker::Impl::revisitMinTracks(const cv::Mat& movers) const {
   const double needed =
       config_.kf_min_tracked_ratio * static_cast<double>(config_.min_tracked_features);
-  if (config_.kf_crowded_min_tracks <= 0 || maskedShare(movers) <= config_.kf_max_masked_share) {
-    return needed;
-  }
+  if (config_.kf_crowded_min_tracks <= 0 || !crowdedView(movers)) return needed;
   return std::min(needed, static_cast<double>(config_.kf_crowded_min_tracks));
 }
 

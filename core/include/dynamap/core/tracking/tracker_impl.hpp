@@ -122,6 +122,9 @@ class Tracker::Impl {
   /// frame tracks its landmarks (pose refined with them); false (nothing changed) if none does.
   bool reuseKeyframe(const RgbdFrame& frame, const cv::Mat& gray, const cv::Mat& track_mask,
                      const cv::Mat& movers, Eigen::Isometry3d& T_W_C, int& inliers);
+  /// The movers cover more than kf_max_masked_share of the frame: few tracks there mean little
+  /// (needKeyframe(), revisitMinTracks()).
+  bool crowdedView(const cv::Mat& movers) const;
   /// The tracks a revisit needs with the old landmarks found again (reuseKeyframe()).
   double revisitMinTracks(const cv::Mat& movers) const;
   /// The keyframes a revisit at T_W_C is judged and tracked against: the nearest 8 within the
