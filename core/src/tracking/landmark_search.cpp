@@ -6,17 +6,22 @@
 
 namespace dynamap {
 
-LandmarkCandidates withoutLandmarks(const LandmarkCandidates& all,
-                                    const std::vector<std::uint64_t>& ids) {
-  const std::unordered_set<std::uint64_t> left_out(ids.begin(), ids.end());
+LandmarkCandidates landmarksWhere(const LandmarkCandidates& all,
+                                  const std::function<bool(std::uint64_t)>& keep) {
   LandmarkCandidates out;
   for (std::size_t i = 0; i < all.ids.size(); ++i) {
-    if (left_out.count(all.ids[i])) continue;
+    if (!keep(all.ids[i])) continue;
     out.ids.push_back(all.ids[i]);
     out.points.push_back(all.points[i]);
     out.descriptors.push_back(all.descriptors.row(static_cast<int>(i)));
   }
   return out;
+}
+
+LandmarkCandidates withoutLandmarks(const LandmarkCandidates& all,
+                                    const std::vector<std::uint64_t>& ids) {
+  const std::unordered_set<std::uint64_t> left_out(ids.begin(), ids.end());
+  return landmarksWhere(all, [&](std::uint64_t id) { return left_out.count(id) == 0; });
 }
 
 std::vector<int> searchByProjection(const OrbFeatures& features, const std::vector<double>& depth_m,

@@ -66,6 +66,7 @@ TrackingResult Tracker::Impl::track(const RgbdFrame& frame) {
   } else {
     Eigen::Isometry3d T_W_C = T_W_C_pred;
     refindLostLandmarks(frame, gray, widened.dynamic_mask, T_W_C_pred);
+    trackLoadedLandmarksOnHeldObjects(frame, gray, widened, T_W_C_pred);
     result.status = solvePose(frame, gray, widened, T_W_C, result.inliers);
     if (result.status != FrameStatus::kLost) {
       // Held-back objects (a teddy taken for a person) are no movers: they do not count. A pose

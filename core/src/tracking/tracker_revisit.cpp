@@ -108,7 +108,13 @@ std::vector<FeatureTrack> Tracker::Impl::findMapLandmarks(
     const Eigen::Isometry3d& T_W_C, const std::vector<std::uint64_t>& sources) {
   const LandmarkCandidates candidates =
       withoutLandmarks(map_.landmarksOf(sources), trackedLandmarks());
-  const OrbFeatures& features = searchKeypoints(gray, track_mask);
+  return matchLandmarks(frame, searchKeypoints(gray, track_mask), candidates, T_W_C);
+}
+
+std::vector<FeatureTrack> Tracker::Impl::matchLandmarks(const RgbdFrame& frame,
+                                                        const OrbFeatures& features,
+                                                        const LandmarkCandidates& candidates,
+                                                        const Eigen::Isometry3d& T_W_C) const {
   std::vector<double> depth(features.keypoints.size());
   for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
     const cv::Point2f& p = features.keypoints[i].pt;

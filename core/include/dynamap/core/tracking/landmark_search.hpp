@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -17,6 +18,10 @@ struct LandmarkCandidates {
   cv::Mat descriptors;
   std::vector<Eigen::Vector3d> points;
 };
+
+/// The landmarks of `all` whose id `keep` accepts, in their order.
+LandmarkCandidates landmarksWhere(const LandmarkCandidates& all,
+                                  const std::function<bool(std::uint64_t)>& keep);
 
 /// `all` without the landmarks in `ids`.
 LandmarkCandidates withoutLandmarks(const LandmarkCandidates& all,

@@ -115,6 +115,11 @@ class Tracker::Impl {
   void relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat& gray,
                              const MotionFilterOutput& filtered, const MotionFilterOutput& widened,
                              TrackingResult& result);
+  /// In a loaded map: the saved landmarks on held-back objects (unconfirmed, no evidence of
+  /// motion) found again where the saved map has them, from the predicted pose, join the tracks.
+  void trackLoadedLandmarksOnHeldObjects(const RgbdFrame& frame, const cv::Mat& gray,
+                                         const MotionFilterOutput& widened,
+                                         const Eigen::Isometry3d& T_W_C_pred);
   /// `movers`: the frame's motion mask without held-back objects (kf_max_masked_share).
   bool needKeyframe(double timestamp_s, const Eigen::Isometry3d& T_W_C,
                     const cv::Mat& movers) const;
@@ -156,6 +161,10 @@ class Tracker::Impl {
   /// once per frame and mask: the lost-landmark search, a revisit and the redundancy check of
   /// one frame search the same ones.
   const OrbFeatures& searchKeypoints(const cv::Mat& gray, const cv::Mat& track_mask);
+  /// `candidates` found among `features` by projection with T_W_C, as tracks.
+  std::vector<FeatureTrack> matchLandmarks(const RgbdFrame& frame, const OrbFeatures& features,
+                                           const LandmarkCandidates& candidates,
+                                           const Eigen::Isometry3d& T_W_C) const;
   /// The landmarks of `sources` the tracks do not follow, found among the frame's keypoints.
   std::vector<FeatureTrack> findMapLandmarks(const RgbdFrame& frame, const cv::Mat& gray,
                                              const cv::Mat& track_mask,
@@ -242,6 +251,8 @@ class Tracker::Impl {
   /// A loaded map not yet relocalized in: its keyframes' static descriptors, for place
   /// recognition (null otherwise).
   std::unique_ptr<PlaceRecognizer> loaded_places_;
+  /// Landmarks of the loaded map (ids below it; 0 without one).
+  std::uint64_t loaded_landmarks_ = 0;
   int loop_generation_ = 0;  ///< the newest loop correction applied (LoopCorrection::generation)
 
   std::vector<FrameRecord> records_;
