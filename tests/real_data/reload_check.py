@@ -4,12 +4,14 @@ the sequence backward in that map. Fails unless run 2 relocalizes within its fir
 its trajectory, moved into the ground truth's frame by run 1's ATE alignment (no alignment of
 its own), has an ATE of at most 2 cm, and it adds at most 10 % new keyframes.
 
-  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...] [--set KEY=VALUE ...]
+  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...] [--run2 CASE2]
+                  [--set KEY=VALUE ...]
 
 --frames: run 1 plays frames FIRST..LAST of the case, run 2 LAST..FIRST (both made by
 ../shared/tools/make_long.py); repeat it to check several spans, one line each. Default: the
-whole sequence. --set: passed to both runs (`dynamap run --set`). Exit status 1 if any span
-fails.
+whole sequence. --run2: run 2 plays CASE2, another day in the same place: the same camera
+frames with other people (teddy, teddy_dyn_dev and teddy_dyn_crowd_dev share theirs). --set:
+passed to both runs (`dynamap run --set`). Exit status 1 if any span fails.
 """
 import argparse, json, os, shutil, subprocess, sys
 
@@ -48,23 +50,33 @@ def played(seq, first, last, out):
     return out
 
 
-def check_span(dynamap, case, first, last, work, sets):
+def sequence_of(case):
+    seq = os.path.join(SHARED, "data", bands.CASES[case][0])
+    if not os.path.isdir(seq):
+        sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
+    return seq
+
+
+def frame_stamps(seq):
+    with open(os.path.join(seq, "rgb.txt")) as f:
+        return [line.split()[0] for line in f if line.strip() and line[0] != "#"]
+
+
+def check_span(dynamap, case, first, last, work, sets, run2_case):
     """Runs 1 and 2 over one span; returns (passed, the line to print)."""
-    source, _, config = bands.CASES[case]
+    config = bands.CASES[case][2]
     case_last = CASES[case]
     extra = ["--config", os.path.join(SOURCE, config)] if config else []
     for kv in sets:
         extra += ["--set", kv]
-    seq = os.path.join(SHARED, "data", source)
-    if not os.path.isdir(seq):
-        sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
+    seq = sequence_of(case)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     saved, align = os.path.join(work, "map"), os.path.join(work, "alignment.txt")
     run1, run2 = os.path.join(work, "run1"), os.path.join(work, "run2")
     forward = seq if (first, last) == (0, case_last) else played(
         seq, first, last, os.path.join(work, "forward"))
-    back = played(seq, last, first, os.path.join(work, "backward"))
+    back = played(sequence_of(run2_case), last, first, os.path.join(work, "backward"))
     run([dynamap, "run", "--sequence", forward, "--out", run1, "--quiet", "--save-map", saved]
         + extra)
     run([dynamap, "evaluate", "--gt", os.path.join(forward, "groundtruth.txt"), "--est",
@@ -78,9 +90,10 @@ def check_span(dynamap, case, first, last, work, sets):
     posed = first_posed_frame(run2)
     ok = (posed is not None and posed <= MAX_RELOCALIZED_FRAME and ate <= MAX_ATE_CM
           and new <= MAX_NEW_KEYFRAME_SHARE * loaded)
+    name = case if run2_case == case else "%s then %s" % (case, run2_case)
     line = ("%s %d-%d: run 2 first posed at frame %s (<= %d), ATE %.2f cm with run 1's "
             "alignment (<= %.1f), %d new keyframes of %d (<= %.0f %%)%s"
-            % (case, first, last, posed, MAX_RELOCALIZED_FRAME, ate, MAX_ATE_CM, new, loaded,
+            % (name, first, last, posed, MAX_RELOCALIZED_FRAME, ate, MAX_ATE_CM, new, loaded,
                100 * MAX_NEW_KEYFRAME_SHARE, "" if ok else "  FAILED"))
     return ok, line
 
@@ -91,8 +104,13 @@ def main():
     ap.add_argument("--dynamap", required=True)
     ap.add_argument("--work", default="/tmp/dynamap_reload_check")
     ap.add_argument("--frames", action="append", default=[], metavar="FIRST,LAST")
+    ap.add_argument("--run2", choices=sorted(CASES), metavar="CASE2")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
+    run2_case = a.run2 or a.case
+    if (bands.CASES[run2_case][2] != bands.CASES[a.case][2]
+            or frame_stamps(sequence_of(run2_case)) != frame_stamps(sequence_of(a.case))):
+        ap.error("--run2 %s: not the same camera frames and config as %s" % (run2_case, a.case))
     last = CASES[a.case]
     try:
         spans = [tuple(int(v) for v in f.split(",")) for f in a.frames] or [(0, last)]
@@ -103,8 +121,8 @@ def main():
             ap.error("--frames %s: need FIRST,LAST with 0 <= FIRST < LAST <= %d" % (span, last))
     failed = 0
     for first, last in spans:
-        ok, line = check_span(a.dynamap, a.case, first, last,
-                              os.path.join(a.work, "%s_%d_%d" % (a.case, first, last)), a.set)
+        work = os.path.join(a.work, "%s_%s_%d_%d" % (a.case, run2_case, first, last))
+        ok, line = check_span(a.dynamap, a.case, first, last, work, a.set, run2_case)
         print(line, flush=True)
         failed += not ok
     return 1 if failed else 0

@@ -93,5 +93,23 @@ TEST(LandmarkSearch, LandmarksBehindTheCameraOrOutsideTheImageAreSkipped) {
   EXPECT_EQ(match[1], -1);
 }
 
+TEST(LandmarkSearch, CandidatesAreFilteredByIdKeepingTheirRowsTogether) {
+  std::mt19937 rng(11);
+  Scene s;
+  for (int i = 0; i < 5; ++i) s.add(rng, 100 + 50 * i, 200, 1.0 + i, 0.0, 1.0 + i, 0);
+  // ids 100..104: the loaded ones of a saved map are those below 103, say, and 101 is tracked.
+  const LandmarkCandidates loaded =
+      landmarksWhere(s.candidates, [](std::uint64_t id) { return id < 103; });
+  const LandmarkCandidates untracked = withoutLandmarks(loaded, {101});
+  ASSERT_EQ(untracked.ids, (std::vector<std::uint64_t>{100, 102}));
+  ASSERT_EQ(untracked.descriptors.rows, 2);
+  ASSERT_EQ(untracked.points.size(), 2u);
+  EXPECT_EQ(cv::norm(untracked.descriptors.row(1), s.candidates.descriptors.row(2),
+                     cv::NORM_HAMMING),
+            0.0);
+  EXPECT_EQ(untracked.points[1], s.candidates.points[2]);
+  EXPECT_TRUE(landmarksWhere(s.candidates, [](std::uint64_t) { return false; }).ids.empty());
+}
+
 }  // namespace
 }  // namespace dynamap
