@@ -37,10 +37,13 @@ def counts(out):
         return json.load(f)["counts"]
 
 
-def first_posed_frame(out):
+def first_posed_frame(out, seq):
+    """The index in seq of run 2's first posed frame: frames before the first relocalization
+    have no pose and are left out of frames.txt."""
     with open(os.path.join(out, "frames.txt")) as f:
-        states = [line.split()[1] for line in f if line.strip() and line[0] != "#"]
-    return next((i for i, s in enumerate(states) if s in ("tracked", "relocalized")), None)
+        posed = [line.split()[0] for line in f if line.strip() and line[0] != "#"
+                 and line.split()[1] in ("tracked", "relocalized")]
+    return frame_stamps(seq).index(posed[0]) if posed else None
 
 
 def played(seq, first, last, out):
@@ -87,7 +90,7 @@ def check_span(dynamap, case, first, last, work, sets, run2_case):
                           "--est", os.path.join(run2, "trajectory.txt"), "--alignment", align,
                           "--json"]))["ate"]["rmse_m"] * 100.0
     loaded, new = counts(run1)["keyframes"], counts(run2)["keyframes"]
-    posed = first_posed_frame(run2)
+    posed = first_posed_frame(run2, back)
     ok = (posed is not None and posed <= MAX_RELOCALIZED_FRAME and ate <= MAX_ATE_CM
           and new <= MAX_NEW_KEYFRAME_SHARE * loaded)
     name = case if run2_case == case else "%s then %s" % (case, run2_case)

@@ -189,5 +189,30 @@ TEST_F(RelocalizerTest, LandmarksMarkedBadAreNotMatched) {
   EXPECT_FALSE(r.ok);
 }
 
+TEST(SeenThroughShare, AWrongPoseSeesThroughTheMapAMoverInFrontHidesIt) {
+  const PinholeCamera camera = cameraPreset("freiburg3");
+  // A wall 2 m in front of the camera, and landmarks on it.
+  cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(2.0f));
+  std::vector<Eigen::Vector3d> wall;
+  for (int v = 40; v < camera.height - 40; v += 40)
+    for (int u = 40; u < camera.width - 40; u += 40) wall.push_back(camera.backProject(u, v, 2.0));
+  int checked = 0;
+  const Eigen::Isometry3d at_wall = Eigen::Isometry3d::Identity();
+  EXPECT_DOUBLE_EQ(seenThroughShare(wall, at_wall, depth, camera, 0.1, 8.0, &checked), 0.0);
+  EXPECT_EQ(checked, static_cast<int>(wall.size()));
+  // Someone 1 m away covers the left half: those landmarks are hidden, not seen through.
+  depth(cv::Rect(0, 0, camera.width / 2, camera.height)).setTo(1.0f);
+  EXPECT_DOUBLE_EQ(seenThroughShare(wall, at_wall, depth, camera, 0.1, 8.0, &checked), 0.0);
+  // A pose 0.5 m too close to the wall puts the landmarks at 1.5 m where 2 m is measured.
+  Eigen::Isometry3d too_close = Eigen::Isometry3d::Identity();
+  too_close.translation().z() = 0.5;
+  EXPECT_NEAR(seenThroughShare(wall, too_close, depth, camera, 0.1, 8.0, &checked), 0.5, 0.1);
+  // Without depth there is nothing to compare.
+  EXPECT_DOUBLE_EQ(seenThroughShare(wall, too_close, cv::Mat::zeros(depth.size(), CV_32FC1),
+                                    camera, 0.1, 8.0, &checked),
+                   0.0);
+  EXPECT_EQ(checked, 0);
+}
+
 }  // namespace
 }  // namespace dynamap

@@ -45,6 +45,27 @@ std::vector<int> bestMatches(const cv::Mat& dist, int max_hamming, float ratio, 
 
 }  // namespace
 
+double seenThroughShare(const std::vector<Eigen::Vector3d>& points_W, const Eigen::Isometry3d& T_W_C,
+                        const cv::Mat& depth_m, const PinholeCamera& camera, double depth_min_m,
+                        double depth_max_m, int* checked) {
+  constexpr double kRelativeMargin = 0.10, kMarginM = 0.05;
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  int compared = 0, seen_through = 0;
+  for (const Eigen::Vector3d& p_W : points_W) {
+    const Eigen::Vector3d p_C = T_C_W * p_W;
+    if (p_C.z() < depth_min_m || p_C.z() > depth_max_m) continue;
+    const Eigen::Vector2d uv = camera.project(p_C);
+    if (uv.x() < 0 || uv.y() < 0 || uv.x() >= camera.width || uv.y() >= camera.height) continue;
+    const double z = sampleDepth(depth_m, static_cast<float>(uv.x()), static_cast<float>(uv.y()),
+                                 depth_min_m, depth_max_m);
+    if (z <= 0.0) continue;
+    ++compared;
+    if (z > p_C.z() * (1.0 + kRelativeMargin) + kMarginM) ++seen_through;
+  }
+  if (checked != nullptr) *checked = compared;
+  return compared > 0 ? static_cast<double>(seen_through) / compared : 0.0;
+}
+
 Relocalizer::Relocalizer(const TrackerConfig& config, const PoseOptimizer& optimizer)
     : config_(config), optimizer_(optimizer) {}
 

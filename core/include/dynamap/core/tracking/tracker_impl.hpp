@@ -112,6 +112,9 @@ class Tracker::Impl {
   /// `mask` (255 = keep away).
   RelocalizationResult relocalizeOutside(const RgbdFrame& frame, const cv::Mat& gray,
                                          const cv::Mat& mask);
+  /// Whether the depth image at T_W_C agrees with `landmarks` (kMaxSeenThroughShare).
+  bool depthAgrees(const LandmarkCandidates& landmarks, const Eigen::Isometry3d& T_W_C,
+                   const cv::Mat& depth_m) const;
   void relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat& gray,
                              const MotionFilterOutput& filtered, const MotionFilterOutput& widened,
                              TrackingResult& result);
