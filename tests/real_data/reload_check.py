@@ -4,13 +4,14 @@ the sequence backward in that map. Fails unless run 2 relocalizes within its fir
 its trajectory, moved into the ground truth's frame by run 1's ATE alignment (no alignment of
 its own), has an ATE of at most 2 cm, and it adds at most 10 % new keyframes.
 
-  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...] [--run2 CASE2]
+  reload_check.py CASE --dynamap BIN [--work DIR] [--frames FIRST,LAST ...] [--run2 CASE2|DIR]
                   [--set KEY=VALUE ...]
 
 --frames: run 1 plays frames FIRST..LAST of the case, run 2 LAST..FIRST (both made by
 ../shared/tools/make_long.py); repeat it to check several spans, one line each. Default: the
 whole sequence. --run2: run 2 plays CASE2, another day in the same place: the same camera
-frames with other people (teddy, teddy_dyn_dev and teddy_dyn_crowd_dev share theirs). --set:
+frames with other people (teddy, teddy_dyn_dev and teddy_dyn_crowd_dev share theirs), or the
+sequence in DIR (e.g. one that ../shared/tools/dyndata made from teddy with other people). --set:
 passed to both runs (`dynamap run --set`). Exit status 1 if any span fails.
 """
 import argparse, json, os, shutil, subprocess, sys
@@ -54,7 +55,8 @@ def played(seq, first, last, out):
 
 
 def sequence_of(case):
-    seq = os.path.join(SHARED, "data", bands.CASES[case][0])
+    """The sequence of a case of bands.py, or the folder `case` names."""
+    seq = case if case not in bands.CASES else os.path.join(SHARED, "data", bands.CASES[case][0])
     if not os.path.isdir(seq):
         sys.exit("reload_check: %s not found (../shared must lie beside the checkout)" % seq)
     return seq
@@ -93,7 +95,7 @@ def check_span(dynamap, case, first, last, work, sets, run2_case):
     posed = first_posed_frame(run2, back)
     ok = (posed is not None and posed <= MAX_RELOCALIZED_FRAME and ate <= MAX_ATE_CM
           and new <= MAX_NEW_KEYFRAME_SHARE * loaded)
-    name = case if run2_case == case else "%s then %s" % (case, run2_case)
+    name = case if run2_case == case else "%s then %s" % (case, os.path.basename(run2_case))
     line = ("%s %d-%d: run 2 first posed at frame %s (<= %d), ATE %.2f cm with run 1's "
             "alignment (<= %.1f), %d new keyframes of %d (<= %.0f %%)%s"
             % (name, first, last, posed, MAX_RELOCALIZED_FRAME, ate, MAX_ATE_CM, new, loaded,
@@ -107,12 +109,15 @@ def main():
     ap.add_argument("--dynamap", required=True)
     ap.add_argument("--work", default="/tmp/dynamap_reload_check")
     ap.add_argument("--frames", action="append", default=[], metavar="FIRST,LAST")
-    ap.add_argument("--run2", choices=sorted(CASES), metavar="CASE2")
+    ap.add_argument("--run2", metavar="CASE2|DIR")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     a = ap.parse_args()
     run2_case = a.run2 or a.case
-    if (bands.CASES[run2_case][2] != bands.CASES[a.case][2]
-            or frame_stamps(sequence_of(run2_case)) != frame_stamps(sequence_of(a.case))):
+    if run2_case not in CASES and not os.path.isfile(os.path.join(run2_case, "rgb.txt")):
+        ap.error("--run2 %s: neither a case (%s) nor a sequence folder" % (run2_case,
+                                                                        ", ".join(sorted(CASES))))
+    same_config = run2_case not in CASES or bands.CASES[run2_case][2] == bands.CASES[a.case][2]
+    if not same_config or frame_stamps(sequence_of(run2_case)) != frame_stamps(sequence_of(a.case)):
         ap.error("--run2 %s: not the same camera frames and config as %s" % (run2_case, a.case))
     last = CASES[a.case]
     try:
@@ -124,7 +129,8 @@ def main():
             ap.error("--frames %s: need FIRST,LAST with 0 <= FIRST < LAST <= %d" % (span, last))
     failed = 0
     for first, last in spans:
-        work = os.path.join(a.work, "%s_%s_%d_%d" % (a.case, run2_case, first, last))
+        work = os.path.join(a.work, "%s_%s_%d_%d" % (a.case, os.path.basename(run2_case.rstrip("/")),
+                                                     first, last))
         ok, line = check_span(a.dynamap, a.case, first, last, work, a.set, run2_case)
         print(line, flush=True)
         failed += not ok
