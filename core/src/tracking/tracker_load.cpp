@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <stdexcept>
-#include <unordered_set>
 
 #include "dynamap/core/tracking/landmark_search.hpp"
 #include "dynamap/core/tracking/tracker_impl.hpp"
@@ -91,7 +90,7 @@ void Tracker::Impl::relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat&
   result.T_W_C = T_W_last_;
   tracks_.clear();
   RelocalizationResult reloc = relocalizeOutside(frame, gray, widened.dynamic_mask);
-  if (!widened.unconfirmed_mask.empty() && cv::countNonZero(widened.unconfirmed_mask) > 0) {
+  if (maskedShare(widened.unconfirmed_mask) > 0.0) {
     RelocalizationResult with_held = relocalizeOutside(frame, gray, certainMask(widened));
     if (with_held.ok && (!reloc.ok || with_held.inliers > reloc.inliers)) {
       reloc = std::move(with_held);
@@ -131,21 +130,15 @@ void Tracker::Impl::relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat&
 void Tracker::Impl::trackLoadedLandmarksOnHeldObjects(const RgbdFrame& frame, const cv::Mat& gray,
                                                       const MotionFilterOutput& widened,
                                                       const Eigen::Isometry3d& T_W_C_pred) {
-  if (loaded_landmarks_ == 0 || widened.unconfirmed_mask.empty() ||
-      cv::countNonZero(widened.unconfirmed_mask) == 0) {
-    return;
-  }
+  if (loaded_landmarks_ == 0 || maskedShare(widened.unconfirmed_mask) == 0.0) return;
   ScopedStageTimer timer(timings_, "refind_held");
-  const std::vector<std::uint64_t> ids = trackedLandmarks();
-  const std::unordered_set<std::uint64_t> followed(ids.begin(), ids.end());
   const LandmarkCandidates candidates = landmarksWhere(
-      map_.landmarksOf(localKeyframes(T_W_C_pred)),
-      [&](std::uint64_t id) { return id < loaded_landmarks_ && followed.count(id) == 0; });
+      withoutLandmarks(map_.landmarksOf(localKeyframes(T_W_C_pred)), trackedLandmarks()),
+      [&](std::uint64_t id) { return id < loaded_landmarks_; });
   if (candidates.ids.empty()) return;
-  cv::Mat held = widened.unconfirmed_mask.clone();
-  held.setTo(0, certainMask(widened));
-  mergeTracks(matchLandmarks(frame, extractor_.extractForSearch(gray, held), candidates,
-                             T_W_C_pred));
+  // The unconfirmed mask holds the held-back objects only (certainMask() is the rest).
+  mergeTracks(matchLandmarks(frame, extractor_.extractForSearch(gray, widened.unconfirmed_mask),
+                             candidates, T_W_C_pred));
 }
 
 }  // namespace dynamap

@@ -21,10 +21,6 @@ struct RelocalizationResult {
   std::vector<cv::Point2f> px;              ///< ... and their pixels in the current frame
 };
 
-/// Recovers the pose of a frame from ORB descriptor matches (brute-force Hamming, ratio test)
-/// against the landmarks of the newest keyframes and of those near the last pose, PnP-RANSAC without a prior, then refinement.
-/// Matches are first searched near the landmarks' projections with the last known pose, then,
-/// if that fails, among all candidates.
 /// Of `points_W` in view at T_W_C with a measured depth at their pixel: the share the depth image
 /// sees through (measured farther than the point by more than 10 % + 5 cm: free space where the
 /// map has a surface). A wrong pose sees through most of the map; a right one through few
@@ -34,6 +30,10 @@ double seenThroughShare(const std::vector<Eigen::Vector3d>& points_W, const Eige
                         const cv::Mat& depth_m, const PinholeCamera& camera, double depth_min_m,
                         double depth_max_m, int* checked);
 
+/// Recovers the pose of a frame from ORB descriptor matches (brute-force Hamming, ratio test)
+/// against the landmarks of the newest keyframes and of those near the last pose, PnP-RANSAC without a prior, then refinement.
+/// Matches are first searched near the landmarks' projections with the last known pose, then,
+/// if that fails, among all candidates.
 class Relocalizer {
  public:
   Relocalizer(const TrackerConfig& config, const PoseOptimizer& optimizer);
