@@ -327,9 +327,10 @@ MapContents LocalMap::contents() const {
 
 void LocalMap::restore(MapContents contents) {
   for (auto& kf : contents.keyframes) kf.loaded = true;
-  // A saved map proves nothing static now (a chair may have moved since): its landmarks count
-  // towards the pose from proven-static landmarks once this run's keyframes see them.
-  for (auto& lm : contents.landmarks) lm.keyframes = 0;
+  // The landmarks keep the saved runs' keyframe counts: the motion filter's pose prior
+  // (Tracker::Impl::priorPose()) takes those seen by static_prior_min_keyframes from the
+  // tracks, which the last frame's pose kept, in this run. A landmark on a chair moved since
+  // the map was saved is not found again where it was, or is the prior's RANSAC outlier.
   std::lock_guard<std::mutex> lock(mutex_);
   landmarks_ = std::move(contents.landmarks);
   keyframes_ = std::move(contents.keyframes);

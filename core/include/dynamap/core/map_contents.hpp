@@ -13,7 +13,8 @@ struct Landmark {
   Eigen::Vector3d p_W;
   cv::Mat descriptor;  ///< 1 x 32 CV_8U
   bool bad = false;    ///< seen on a moving object: never used again
-  /// Keyframes of this run that observed it (LocalMap::restore() starts a saved map's at 0).
+  /// Keyframes that observed it: of this run and of the runs that saved the map it was loaded
+  /// from.
   int keyframes = 0;
 };
 
