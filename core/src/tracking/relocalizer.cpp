@@ -74,7 +74,10 @@ RelocalizationResult Relocalizer::relocalize(const OrbFeatures& features, const 
                                              const Eigen::Isometry3d& T_W_C_last) const {
   if (features.keypoints.size() < 6) return {};
   const LandmarkCandidates c = map.landmarksOf(candidateKeyframes(map, T_W_C_last));
-  return relocalizeNear(features, depth_m, c, camera, T_W_C_last, &T_W_C_last);
+  const int fewest = config_.reloc_near_last_min_inliers > 0
+                         ? std::min(config_.reloc_min_inliers, config_.reloc_near_last_min_inliers)
+                         : config_.reloc_min_inliers;
+  return relocalizeNear(features, depth_m, c, camera, T_W_C_last, &T_W_C_last, fewest);
 }
 
 // The newest keyframes, and as many again of those nearest the last pose: on a revisit that
@@ -97,8 +100,9 @@ RelocalizationResult Relocalizer::relocalizeAgainst(const OrbFeatures& features,
                                                     const cv::Mat& depth_m,
                                                     const LandmarkCandidates& c,
                                                     const PinholeCamera& camera,
-                                                    const Eigen::Isometry3d& T_W_C_hint) const {
-  return relocalizeNear(features, depth_m, c, camera, T_W_C_hint, nullptr);
+                                                    const Eigen::Isometry3d& T_W_C_hint,
+                                                    int fewest_matches) const {
+  return relocalizeNear(features, depth_m, c, camera, T_W_C_hint, nullptr, fewest_matches);
 }
 
 RelocalizationResult Relocalizer::relocalizeNear(const OrbFeatures& features,
@@ -106,8 +110,10 @@ RelocalizationResult Relocalizer::relocalizeNear(const OrbFeatures& features,
                                                  const LandmarkCandidates& c,
                                                  const PinholeCamera& camera,
                                                  const Eigen::Isometry3d& T_W_C_hint,
-                                                 const Eigen::Isometry3d* T_W_C_last) const {
+                                                 const Eigen::Isometry3d* T_W_C_last,
+                                                 int fewest_matches) const {
   if (features.keypoints.size() < 6 || c.ids.size() < 6) return {};
+  RelocalizationResult best;  // the pose with most inliers of the tries that had too few
   cv::Mat dist;
   cv::batchDistance(features.descriptors, c.descriptors, dist, CV_32S, cv::noArray(),
                     cv::NORM_HAMMING);
@@ -132,8 +138,9 @@ RelocalizationResult Relocalizer::relocalizeNear(const OrbFeatures& features,
           return (proj[ti] - Eigen::Vector2d(p.x, p.y)).squaredNorm() < r2;
         });
     RelocalizationResult result =
-        solve(features, dist, depth_m, c.ids, c.points, guided, T_W_C_last);
+        solve(features, dist, depth_m, c.ids, c.points, guided, T_W_C_last, fewest_matches);
     if (result.ok) return result;
+    if (result.inliers > best.inliers) best = std::move(result);
   }
   // 2) Global: any landmark of the recent keyframes, ratio test and mutual nearest neighbours.
   auto global = bestMatches(dist, config_.reloc_max_hamming,
@@ -145,7 +152,9 @@ RelocalizationResult Relocalizer::relocalizeNear(const OrbFeatures& features,
     cv::minMaxLoc(dist.col(global[q]), &min_val, nullptr, &min_loc);
     if (min_loc.y != static_cast<int>(q)) global[q] = -1;
   }
-  return solve(features, dist, depth_m, c.ids, c.points, global, T_W_C_last);
+  RelocalizationResult result =
+      solve(features, dist, depth_m, c.ids, c.points, global, T_W_C_last, fewest_matches);
+  return result.ok || result.inliers > best.inliers ? result : best;
 }
 
 RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::Mat& dist,
@@ -153,7 +162,8 @@ RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::M
                                         const std::vector<std::uint64_t>& ids,
                                         const std::vector<Eigen::Vector3d>& points,
                                         const std::vector<int>& match,
-                                        const Eigen::Isometry3d* T_W_C_last) const {
+                                        const Eigen::Isometry3d* T_W_C_last,
+                                        int fewest_matches) const {
   RelocalizationResult result;
   std::vector<PoseCorrespondence> corr;
   std::vector<int> query_index;
@@ -178,16 +188,12 @@ RelocalizationResult Relocalizer::solve(const OrbFeatures& features, const cv::M
     corr.push_back(pc);
     query_index.push_back(static_cast<int>(q));
   }
-  const int fewest = T_W_C_last != nullptr && config_.reloc_near_last_min_inliers > 0
-                         ? std::min(config_.reloc_min_inliers, config_.reloc_near_last_min_inliers)
-                         : config_.reloc_min_inliers;
-  if (static_cast<int>(corr.size()) < fewest) return result;
+  if (static_cast<int>(corr.size()) < fewest_matches) return result;
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   std::vector<std::uint8_t> inlier;
   if (!optimizer_.ransac(corr, T_W_C, inlier, false, kRelocRansacIterations)) return result;
   const int count = optimizer_.refine(corr, T_W_C, inlier);
-  if (!enoughInliers(count, T_W_C, T_W_C_last)) return result;
-  result.ok = true;
+  result.ok = enoughInliers(count, T_W_C, T_W_C_last);
   result.T_W_C = T_W_C;
   result.inliers = count;
   for (std::size_t i = 0; i < corr.size(); ++i) {

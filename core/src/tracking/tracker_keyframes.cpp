@@ -245,7 +245,7 @@ void Tracker::Impl::record(double timestamp_s, FrameStatus status, const Eigen::
   r.timestamp_s = timestamp_s;
   r.status = status;
   r.T_W_C = T_W_C;
-  r.unposed = loaded_places_ != nullptr;
+  r.unposed = loaded_places_ != nullptr && status == FrameStatus::kLost;
   if (initialized_) {
     r.has_ref = true;
     r.ref_kf = ref_kf_;

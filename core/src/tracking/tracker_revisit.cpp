@@ -21,16 +21,14 @@ constexpr double kRevisitMaxStepDeg = 3.0;
 constexpr double kOnlineCullMaxStepM = 0.01;
 constexpr double kOnlineCullMaxStepDeg = 0.5;
 
-/// Whether the pose with the old landmarks lies within max_m / max_deg of the pose of the
-/// frame's own tracks.
-bool smallStep(const Eigen::Isometry3d& T_W_C, const Eigen::Isometry3d& T_W_C_old, double max_m,
+}  // namespace
+
+bool smallStep(const Eigen::Isometry3d& T_W_C_a, const Eigen::Isometry3d& T_W_C_b, double max_m,
                double max_deg) {
-  const Eigen::Isometry3d step = T_W_C.inverse() * T_W_C_old;
+  const Eigen::Isometry3d step = T_W_C_a.inverse() * T_W_C_b;
   return step.translation().norm() <= max_m &&
          Eigen::AngleAxisd(step.linear()).angle() <= max_deg * M_PI / 180.0;
 }
-
-}  // namespace
 
 // A track within kSamePointPx of a re-found landmark follows the same point under a newer
 // landmark: the older one takes its place.

@@ -15,6 +15,7 @@ namespace dynamap {
 
 struct RelocalizationResult {
   bool ok = false;
+  /// With !ok: the pose with most inliers found, too few to accept (0 inliers: none found).
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   int inliers = 0;
   std::vector<std::uint64_t> landmark_ids;  ///< inlier matches ...
@@ -43,16 +44,19 @@ class Relocalizer {
                                   const LocalMap& map, const PinholeCamera& camera,
                                   const Eigen::Isometry3d& T_W_C_last) const;
   /// The same against given candidates (e.g. the landmarks around the keyframes that place
-  /// recognition found), `T_W_C_hint` guiding the first search.
+  /// recognition found), `T_W_C_hint` guiding the first search; a pose is solved from
+  /// `fewest_matches` matches on.
   RelocalizationResult relocalizeAgainst(const OrbFeatures& features, const cv::Mat& depth_m,
                                          const LandmarkCandidates& c, const PinholeCamera& camera,
-                                         const Eigen::Isometry3d& T_W_C_hint) const;
+                                         const Eigen::Isometry3d& T_W_C_hint,
+                                         int fewest_matches) const;
 
  private:
   RelocalizationResult relocalizeNear(const OrbFeatures& features, const cv::Mat& depth_m,
                                       const LandmarkCandidates& c, const PinholeCamera& camera,
                                       const Eigen::Isometry3d& T_W_C_hint,
-                                      const Eigen::Isometry3d* T_W_C_last) const;
+                                      const Eigen::Isometry3d* T_W_C_last,
+                                      int fewest_matches) const;
   std::vector<std::uint64_t> candidateKeyframes(const LocalMap& map,
                                                 const Eigen::Isometry3d& T_W_C_last) const;
   /// match[q] = candidate index of query q or -1.
@@ -60,7 +64,7 @@ class Relocalizer {
                              const cv::Mat& depth_m, const std::vector<std::uint64_t>& ids,
                              const std::vector<Eigen::Vector3d>& points,
                              const std::vector<int>& match,
-                             const Eigen::Isometry3d* T_W_C_last) const;
+                             const Eigen::Isometry3d* T_W_C_last, int fewest_matches) const;
   /// Enough inliers for `T_W_C`: reloc_min_inliers, or fewer near `T_W_C_last`.
   bool enoughInliers(int inliers, const Eigen::Isometry3d& T_W_C,
                      const Eigen::Isometry3d* T_W_C_last) const;

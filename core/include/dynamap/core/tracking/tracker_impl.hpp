@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -35,12 +36,16 @@ struct FrameRecord {
   Eigen::Isometry3d T_ref_C = Eigen::Isometry3d::Identity();  ///< used when has_ref
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();    ///< used otherwise
   /// Lost before the first relocalization in a loaded map: no pose in its frame (left out of
-  /// the trajectory).
+  /// the trajectory). A frame posed by reportAgreeingPose() meanwhile has one.
   bool unposed = false;
 };
 
 /// Share of the image's pixels that `mask` (CV_8UC1, may be empty) sets.
 double maskedShare(const cv::Mat& mask);
+
+/// Whether T_W_C_b lies within max_m and max_deg of T_W_C_a.
+bool smallStep(const Eigen::Isometry3d& T_W_C_a, const Eigen::Isometry3d& T_W_C_b, double max_m,
+               double max_deg);
 
 class Tracker::Impl {
  public:
@@ -118,6 +123,9 @@ class Tracker::Impl {
   void relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat& gray,
                              const MotionFilterOutput& filtered, const MotionFilterOutput& widened,
                              TrackingResult& result);
+  /// Before the first pose in a loaded map: `candidate` (too few inliers to start tracking) is
+  /// the frame's pose if the frame before gave the same (kAgreeingMinInliers, kAgreeingStep*).
+  void reportAgreeingPose(const RelocalizationResult& candidate, TrackingResult& result);
   /// In a loaded map: the saved landmarks on held-back objects (unconfirmed, no evidence of
   /// motion) found again where the saved map has them, from the predicted pose, join the tracks.
   void trackLoadedLandmarksOnHeldObjects(const RgbdFrame& frame, const cv::Mat& gray,
@@ -256,6 +264,8 @@ class Tracker::Impl {
   std::unique_ptr<PlaceRecognizer> loaded_places_;
   /// Landmarks of the loaded map (ids below it; 0 without one).
   std::uint64_t loaded_landmarks_ = 0;
+  /// The last frame's candidate first pose in a loaded map (reportAgreeingPose()), if any.
+  std::optional<Eigen::Isometry3d> loaded_candidate_;
   int loop_generation_ = 0;  ///< the newest loop correction applied (LoopCorrection::generation)
 
   std::vector<FrameRecord> records_;
