@@ -90,32 +90,14 @@ TEST(MoverTracks, ABoxPushedOverTheFloorIsFoundWithoutADetector) {
   EXPECT_LT(r.max_pose_error_m, 0.02);
 }
 
-/// The room's map as a run over it without the box saved it.
-MapContents savedRoomMap(int frames) {
-  test::SyntheticScene room(cameraPreset("freiburg3"), 21);
-  room.addDefaultRoom();
-  Tracker tracker(room.camera(), TrackerConfig{}, nullptr);
-  for (int i = 0; i < frames; ++i) {
-    const test::RenderedFrame r = room.render(test::smoothPath(i, frames), i * kFramePeriodS);
-    RgbdFrame f;
-    f.index = static_cast<std::size_t>(i);
-    f.timestamp_s = i * kFramePeriodS;
-    f.bgr = r.bgr;
-    f.depth_m = r.depth_m;
-    tracker.track(f);
-  }
-  tracker.finish();
-  return tracker.mapContents();
-}
-
 // A later run in the room's saved map reuses its keyframes and makes almost none of its own: the
 // motion filter's pose prior must come from the saved landmarks (their keyframe counts kept), or
 // the filter runs without a pose and geometry finds no mover (LocalMap::restore() starting the
 // counts at 0: box masked 0.08, 0.89 now).
 TEST(MoverTracks, ABoxPushedInASavedMapIsFoundWithoutADetector) {
-  const MapContents saved = savedRoomMap(60);
   test::SyntheticScene scene(cameraPreset("freiburg3"), 21);
   scene.addDefaultRoom();
+  const MapContents saved = test::savedMapAlongSmoothPath(scene, 60);  // the room without the box
   addPushedCabinet(scene, std::numeric_limits<double>::infinity());
   const MoverRun r = run(scene, 60, 25, 60, &saved);
   print("pushed box, run in a saved map", r);

@@ -4,6 +4,9 @@
 
 #include <Eigen/Geometry>
 
+#include "dynamap/core/tracker.hpp"
+#include "synthetic_scene.hpp"
+
 namespace dynamap::test {
 
 /// Smooth 6-DoF camera path: ~2 cm and ~0.7 deg per frame for n = 60.
@@ -19,6 +22,23 @@ inline Eigen::Isometry3d smoothPath(int i, int n) {
                 Eigen::AngleAxisd(3 * deg * std::sin(two_pi * s + 2.0), Eigen::Vector3d::UnitZ()))
                    .toRotationMatrix();
   return T;
+}
+
+/// The map a tracker (default config, no motion filter) saves after frames [0, frames) of
+/// `scene` along smoothPath(i, frames), 30 frames/s: poses in the frame of smoothPath(0).
+inline MapContents savedMapAlongSmoothPath(const SyntheticScene& scene, int frames) {
+  Tracker tracker(scene.camera(), TrackerConfig{}, nullptr);
+  for (int i = 0; i < frames; ++i) {
+    const RenderedFrame r = scene.render(smoothPath(i, frames), i / 30.0);
+    RgbdFrame f;
+    f.index = static_cast<std::size_t>(i);
+    f.timestamp_s = i / 30.0;
+    f.bgr = r.bgr;
+    f.depth_m = r.depth_m;
+    tracker.track(f);
+  }
+  tracker.finish();
+  return tracker.mapContents();
 }
 
 }  // namespace dynamap::test

@@ -112,7 +112,9 @@ class Tracker {
   /// landmarks around the best ones), frames are kLost and make no keyframe; from then on poses
   /// are in the saved map's frame, its keyframes are held fixed and revisits reuse them. The
   /// frames before the first relocalization have no pose: finalTrajectory() and
-  /// frameStatuses() leave them out (stats() counts them lost).
+  /// frameStatuses() leave them out (stats() counts them lost); but a frame whose pose, with
+  /// too few inliers to track from, agrees with the frame before's is kRelocalized with it
+  /// (tracking still waits).
   void loadMap(MapContents contents);
 
   class Impl;
