@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
 
 #include "dynamap/core/tracking/landmark_search.hpp"
 #include "dynamap/core/tracking/tracker_impl.hpp"
@@ -102,7 +103,7 @@ void Tracker::Impl::relocalizeInLoadedMap(const RgbdFrame& frame, const cv::Mat&
   RelocalizationResult reloc = relocalizeOutside(frame, gray, widened.dynamic_mask);
   if (maskedShare(widened.unconfirmed_mask) > 0.0) {
     RelocalizationResult with_held = relocalizeOutside(frame, gray, certainMask(widened));
-    if (with_held.ok > reloc.ok || (with_held.ok == reloc.ok && with_held.inliers > reloc.inliers)) {
+    if (std::tie(with_held.ok, with_held.inliers) > std::tie(reloc.ok, reloc.inliers)) {
       reloc = std::move(with_held);
     }
   }
